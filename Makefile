@@ -1,0 +1,27 @@
+# Quick start: `make demo` (sets up ./.venv, then runs the demo), `make test`.
+VENV ?= .venv
+BIN := $(VENV)/bin
+PYTEST_ARGS ?=
+
+.PHONY: setup demo test test-all lint bench clean
+
+setup:  ## create ./.venv with everything installed (idempotent; seconds when up to date)
+	bash scripts/setup.sh
+
+demo: setup  ## the main job on the embedded defaults
+	$(BIN)/ara demo
+
+test: setup  ## the default (fast) test suite
+	$(BIN)/pytest -m "not slow and not gpu" $(PYTEST_ARGS)
+
+test-all: setup  ## every test, slow ones included
+	$(BIN)/pytest $(PYTEST_ARGS)
+
+lint: setup
+	$(BIN)/ruff check ara grammars data tests bench
+
+bench: setup  ## measurements, printed as tables; not part of the tests
+	$(BIN)/python bench/spot_bounds.py
+
+clean:
+	rm -rf data/prepared .pytest_cache

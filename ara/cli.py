@@ -1,0 +1,35 @@
+"""``ara``: the toolkit's command line. It composes each area's commands; no logic here."""
+
+from __future__ import annotations
+
+import typer
+
+from ara import __version__
+from ara.data.cli import data_app
+from ara.demo import demo_cmd
+from ara.grammars.cli import grammar_cmd, stl_app
+
+app = typer.Typer(
+    help="ask-reason-assist: natural language to Signal Temporal Logic with guaranteed "
+         "syntax, for multi-robot help requests.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+app.add_typer(stl_app, name="stl")
+app.add_typer(data_app, name="data")
+app.command("grammar")(grammar_cmd)
+app.command("demo")(demo_cmd)
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"ara {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                 help="Print the version and exit."),
+) -> None:
+    """Run `ara COMMAND --help` for each command's options."""

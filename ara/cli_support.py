@@ -1,0 +1,39 @@
+"""What every subcommand shares: turning toolkit errors into exit code 2 and output."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import typer
+
+from ara.errors import AraError
+
+#: Exit code for bad input (invalid formula, unknown option value, missing data).
+EXIT_BAD_INPUT = 2
+
+
+@contextmanager
+def user_errors() -> Iterator[None]:
+    """Print a toolkit error as ``error: ...`` on stderr and exit with code 2."""
+    try:
+        yield
+    except AraError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def emit(value: Any, as_json: bool, human: Callable[[Any], str] | None = None) -> None:
+    """Print ``value`` as one JSON object, or as the text ``human`` makes of it."""
+    if as_json:
+        sys.stdout.write(json.dumps(value, sort_keys=True) + "\n")
+    else:
+        typer.echo(human(value) if human else value)
+
+
+def split_list(text: str) -> tuple[str, ...]:
+    """``"a, b,c"`` -> ``("a", "b", "c")``."""
+    return tuple(item.strip() for item in text.split(",") if item.strip())

@@ -1,0 +1,1 @@
+"""Placeholder package: its code lands with its own issue."""

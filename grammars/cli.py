@@ -1,0 +1,95 @@
+"""``ara stl ...`` and ``ara grammar``: the language core from the command line."""
+
+from __future__ import annotations
+
+from enum import Enum
+
+import typer
+
+from ara.cli_support import emit, split_list, user_errors
+from ara.grammars.parser import parse
+from ara.grammars.printer import to_text
+from ara.grammars.stl_grammar import build_grammar
+from ara.grammars.syntax import Syntax
+
+stl_app = typer.Typer(
+    help="Parse, print and compare STL formulas (see the README for the syntax).",
+    no_args_is_help=True,
+)
+
+JSON_OPT = typer.Option(False, "--json", help="Print one JSON object instead of text.")
+
+
+@stl_app.command("parse")
+def parse_cmd(
+    formula: str = typer.Argument(..., help="A formula, e.g. 'F(a) & G[0,30](!b)'."),
+    as_json: bool = JSON_OPT,
+) -> None:
+    """Print FORMULA in canonical form; exit 2 naming the position if it is invalid."""
+    with user_errors():
+        tree = parse(formula)
+    emit({"stl": to_text(tree), "valid": True}, as_json, lambda v: v["stl"])
+
+
+@stl_app.command("equiv")
+def equiv_cmd(
+    a: str = typer.Argument(..., help="First formula."),
+    b: str = typer.Argument(..., help="Second formula."),
+    as_json: bool = JSON_OPT,
+) -> None:
+    """Whether A and B hold on exactly the same traces (decided by Spot)."""
+    from ara.grammars.spot_bridge import equivalent
+
+    with user_errors():
+        result = equivalent(parse(a), parse(b))
+    emit({"equivalent": result}, as_json, lambda v: "equivalent" if result else "not equivalent")
+
+
+@stl_app.command("implies")
+def implies_cmd(
+    a: str = typer.Argument(..., help="Premise."),
+    b: str = typer.Argument(..., help="Conclusion."),
+    as_json: bool = JSON_OPT,
+) -> None:
+    """Whether A implies B: every trace satisfying A satisfies B (decided by Spot)."""
+    from ara.grammars.spot_bridge import implies
+
+    with user_errors():
+        result = implies(parse(a), parse(b))
+    emit({"implies": result}, as_json, lambda v: "A implies B" if result else "A does not imply B")
+
+
+class GrammarFormat(str, Enum):
+    gbnf = "gbnf"
+    lark = "lark"
+
+
+def grammar_cmd(
+    aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, e.g. a,b,c."),
+    intervals: bool = typer.Option(False, "--intervals", help="Allow F[lo,hi], G[lo,hi], U[lo,hi]."),
+    max_bound: int = typer.Option(1000, "--max-bound", help="Largest time bound in an interval."),
+    allow_inf: bool = typer.Option(False, "--allow-inf", help="Allow [lo,inf] intervals."),
+    allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),
+    relaxed: bool = typer.Option(
+        False, "--relaxed",
+        help="Paper-style layout: precedence, optional parentheses and spaces, ! or ~.",
+    ),
+    max_depth: int = typer.Option(
+        None, "--max-depth", help="Canonical layout: bound the nesting depth (finite language)."
+    ),
+    max_args: int = typer.Option(
+        None, "--max-args", help="Canonical layout: bound the arguments of one & or |."
+    ),
+    fmt: GrammarFormat = typer.Option(GrammarFormat.gbnf, "--format", help="Output format."),
+) -> None:
+    """Print the grammar of STL over the given propositions (GBNF for llama.cpp, Lark for
+    outlines/llguidance). The parser accepts exactly the strings this grammar admits."""
+    with user_errors():
+        syntax = Syntax(aps=split_list(aps), intervals=intervals, max_bound=max_bound,
+                        allow_inf=allow_inf, allow_next=allow_next, relaxed=relaxed,
+                        max_depth=max_depth, max_args=max_args)
+        built = build_grammar(syntax)
+    text = built.grammar.to_gbnf() if fmt is GrammarFormat.gbnf else built.grammar.to_lark()
+    comment = "#" if fmt is GrammarFormat.gbnf else "//"
+    typer.echo(f"{comment} ara grammar {built.version} sha256:{built.sha256[:16]}")
+    typer.echo(text, nl=False)

@@ -1,0 +1,176 @@
+"""Logical checks through Spot: equivalence and implication of formulas.
+
+Spot decides LTL over infinite words. Discrete-time STL intervals map onto Spot's
+bounded operators (``F[a..b]``, ``G[a..b]``, ``X[n]``); Spot has no bounded until,
+so it is expanded first:
+
+.. math::
+
+    p \\mathbin{U_{[a,b]}} q \\;\\equiv\\; G_{[0,a-1]}\\, p \\wedge F_{[a,b]}\\, q
+        \\wedge X^{a} (p \\mathbin{U} q)
+
+(the first conjunct is dropped for ``a = 0``; with ``b = inf`` the second is implied by
+the third). ``tests/grammars/test_spot_bridge.py`` checks this expansion against a
+brute-force evaluator on random lasso words.
+
+Spot unrolls a bound ``n`` into ``n`` nested ``X``, so automata grow with the bounds.
+Formulas whose intervals mention a number above :data:`SPOT_MAX_BOUND` are refused
+with :class:`~ara.errors.BoundTooLargeError` rather than left to run for minutes.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from ara.errors import BoundTooLargeError
+from ara.grammars.ast import (
+    Always,
+    And,
+    Atom,
+    Const,
+    Eventually,
+    Formula,
+    Iff,
+    Implies,
+    Interval,
+    Next,
+    Not,
+    Or,
+    Until,
+    max_bound,
+)
+from ara.grammars.printer import to_text
+
+#: Largest interval bound the Spot checks accept (see ``bench/spot_bounds.py``).
+SPOT_MAX_BOUND = 256
+
+
+def to_spot_text(formula: Formula) -> str:
+    """The formula in Spot's syntax, every proposition double-quoted.
+
+    Quoting keeps names such as ``Fa`` or ``X1`` from being read as operators.
+    """
+    if isinstance(formula, Atom):
+        return f'"{formula.name}"'
+    if isinstance(formula, Const):
+        return "1" if formula.value else "0"
+    if isinstance(formula, Not):
+        return f"!({to_spot_text(formula.arg)})"
+    if isinstance(formula, (And, Or)):
+        op = " & " if isinstance(formula, And) else " | "
+        return "(" + op.join(to_spot_text(a) for a in formula.args) + ")"
+    if isinstance(formula, Implies):
+        return f"({to_spot_text(formula.lhs)} -> {to_spot_text(formula.rhs)})"
+    if isinstance(formula, Iff):
+        return f"({to_spot_text(formula.lhs)} <-> {to_spot_text(formula.rhs)})"
+    if isinstance(formula, Next):
+        return f"X({to_spot_text(formula.arg)})"
+    if isinstance(formula, (Eventually, Always)):
+        op = "F" if isinstance(formula, Eventually) else "G"
+        return f"{op}{_spot_interval(formula.interval)}({to_spot_text(formula.arg)})"
+    if isinstance(formula, Until):
+        return _until_text(formula.lhs, formula.rhs, formula.interval)
+    raise TypeError(f"not a formula node: {formula!r}")
+
+
+def _spot_interval(interval: Interval | None) -> str:
+    if interval is None:
+        return ""
+    hi = "" if interval.hi is None else str(interval.hi)
+    return f"[{interval.lo}..{hi}]"
+
+
+def _until_text(lhs: Formula, rhs: Formula, interval: Interval | None) -> str:
+    p, q = to_spot_text(lhs), to_spot_text(rhs)
+    untimed = f"({p} U {q})"
+    if interval is None:
+        return untimed
+    a, b = interval.lo, interval.hi
+    parts = []
+    if a > 0:
+        parts.append(f"G[0..{a - 1}]({p})")
+    if b is not None:
+        parts.append(f"F[{a}..{b}]({q})")
+    parts.append(f"X[{a}]{untimed}" if a > 0 else untimed)
+    return "(" + " & ".join(parts) + ")"
+
+
+def _check_bounds(*formulas: Formula) -> None:
+    for f in formulas:
+        bound = max_bound(f)
+        if bound > SPOT_MAX_BOUND:
+            raise BoundTooLargeError(
+                f"time bound {bound} in {to_text(f)!r} exceeds SPOT_MAX_BOUND={SPOT_MAX_BOUND}: "
+                "Spot unrolls bounds into nested X and the check would not finish in "
+                "reasonable time; rescale the time unit or raise "
+                "ara.grammars.spot_bridge.SPOT_MAX_BOUND at your own cost"
+            )
+
+
+def to_spot(formula: Formula):
+    """The formula as a ``spot.formula``.
+
+    Raises:
+        BoundTooLargeError: If an interval bound exceeds :data:`SPOT_MAX_BOUND`.
+    """
+    _check_bounds(formula)
+    return _spot_formula(to_spot_text(formula))
+
+
+@lru_cache(maxsize=4096)
+def _spot_formula(text: str):
+    import spot  # imported lazily: importing spot costs ~0.3 s
+
+    return spot.formula(text)
+
+
+def equivalent(a: Formula, b: Formula) -> bool:
+    """Whether ``a`` and ``b`` hold on exactly the same (infinite, discrete-time) traces."""
+    _check_bounds(a, b)
+    return _equivalent(to_spot_text(a), to_spot_text(b))
+
+
+def implies(a: Formula, b: Formula) -> bool:
+    """Whether every trace satisfying ``a`` satisfies ``b`` (``a => b``).
+
+    ``spot.contains(x, y)`` asks whether the language of ``y`` is contained in that
+    of ``x``, so ``a => b`` is ``spot.contains(b, a)``.
+    """
+    _check_bounds(a, b)
+    return _implies(to_spot_text(a), to_spot_text(b))
+
+
+@lru_cache(maxsize=65536)
+def _equivalent(a: str, b: str) -> bool:
+    import spot
+
+    return bool(spot.are_equivalent(_spot_formula(a), _spot_formula(b)))
+
+
+@lru_cache(maxsize=65536)
+def _implies(a: str, b: str) -> bool:
+    import spot
+
+    return bool(spot.contains(_spot_formula(b), _spot_formula(a)))
+
+
+def accepts_word(formula: Formula, prefix: list[frozenset[str]], loop: list[frozenset[str]],
+                 aps: tuple[str, ...]) -> bool:
+    """Whether Spot's automaton for ``formula`` accepts the lasso word ``prefix loop^ω``.
+
+    Args:
+        formula: The formula.
+        prefix: Letters before the loop; each letter is the set of true propositions.
+        loop: The non-empty repeated part.
+        aps: Every proposition that letters may mention (absent ones are false).
+    """
+    import spot
+
+    def letter(true: frozenset[str]) -> str:
+        return " & ".join(f'"{p}"' if p in true else f'!"{p}"' for p in aps) or "1"
+
+    head = "; ".join(letter(s) for s in prefix)
+    text = (head + "; " if head else "") + "cycle{" + "; ".join(letter(s) for s in loop) + "}"
+    automaton = spot.translate(to_spot(formula))
+    word = spot.parse_word(text, automaton.get_dict())
+    return bool(automaton.intersects(word.as_automaton()))

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Create ./.venv and install the toolkit with everything it needs, idempotently.
+#
+#   bash scripts/setup.sh          # or: make setup
+#
+# A second run with unchanged pyproject.toml and this script returns in about a second:
+# a stamp file in .venv records the hash of both. llama-cpp-python compiles from source
+# the first time (10-20 min on 2 cores); pip caches the wheel, so later venvs reuse it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+VENV=${ARA_VENV:-.venv}
+PYTHON=${PYTHON:-python3}
+stamp="$VENV/.ara-setup-$(cat pyproject.toml scripts/setup.sh | sha256sum | cut -c1-16)"
+
+if [ -f "$stamp" ]; then
+    echo "setup: $VENV is up to date ($(basename "$stamp"))"
+    exit 0
+fi
+
+[ -x "$VENV/bin/python" ] || "$PYTHON" -m venv "$VENV"
+pip() { "$VENV/bin/python" -m pip --disable-pip-version-check "$@"; }
+
+# torch first and pinned: on these machines torch==2.13.0 is a local CPU wheel, while any
+# range admitting newer releases would pull several GB of CUDA packages.
+pip install -q torch==2.13.0
+
+# A native build of llama.cpp uses AMX instructions that these CPUs advertise but refuse
+# (SIGILL); these flags keep it to AVX2/FMA/F16C.
+export CMAKE_ARGS="${CMAKE_ARGS:--DGGML_NATIVE=OFF -DGGML_AVX2=ON -DGGML_FMA=ON -DGGML_F16C=ON -DLLAVA_BUILD=OFF}"
+echo "setup: installing the toolkit (llama-cpp-python builds from source once, ~10-20 min)"
+pip install -q -e ".[all]"
+
+rm -f "$VENV"/.ara-setup-*
+touch "$stamp"
+echo "setup: done ($VENV)"

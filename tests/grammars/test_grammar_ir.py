@@ -1,0 +1,62 @@
+"""The grammar IR: number ranges, emitters, lengths, provenance."""
+
+import re
+
+import pytest
+
+from ara.errors import ConfigError
+from ara.grammars import GRAMMAR_VERSION, Syntax, build_grammar
+from ara.grammars.grammar_ir import Chars, Lit
+from ara.grammars.stl_grammar import number_patterns
+
+
+def _matches(pattern, text):
+    if len(pattern) != len(text):
+        return False
+    for item, ch in zip(pattern, text):
+        if isinstance(item, Lit) and item.text != ch:
+            return False
+        if isinstance(item, Chars) and ch not in item.members():
+            return False
+    return True
+
+
+@pytest.mark.parametrize(("lo", "hi"), [(0, 0), (0, 9), (3, 7), (7, 123), (10, 99), (0, 1000),
+                                        (99, 101), (456, 951)])
+def test_number_patterns_match_exactly_the_range(lo, hi):
+    """Tests every numeral 0..1200 (and leading-zero forms) against the patterns."""
+    patterns = number_patterns(lo, hi)
+    for n in range(0, 1201):
+        assert any(_matches(p, str(n)) for p in patterns) == (lo <= n <= hi), n
+        assert not any(_matches(p, "0" + str(n)) for p in patterns)
+
+
+def test_emitted_texts_name_each_rule_once():
+    """Tests the GBNF and Lark texts: one line per rule, start rules named as each needs."""
+    grammar = build_grammar(Syntax(aps=("a", "b"), intervals=True, max_bound=20)).grammar
+    gbnf, lark = grammar.to_gbnf(), grammar.to_lark()
+    assert re.search(r"^root ::= ", gbnf, re.M) and re.search(r"^start: ", lark, re.M)
+    assert len(gbnf.splitlines()) == len(lark.splitlines()) == len(grammar.rules)
+    assert "_" not in "".join(line.split(" ::= ")[0] for line in gbnf.splitlines())
+
+
+def test_grammar_provenance_records_version_and_hash():
+    """Tests what outputs record about the grammar they used."""
+    built = build_grammar(Syntax(aps=("a", "b")))
+    prov = built.provenance()
+    assert prov["grammar_version"] == GRAMMAR_VERSION
+    assert prov["grammar_sha256"] == built.grammar.sha256() and len(prov["grammar_sha256"]) == 64
+    assert prov["syntax"]["aps"] == ["a", "b"]
+    assert build_grammar(Syntax(aps=("a", "c"))).sha256 != built.sha256
+
+
+def test_min_length_is_the_shortest_formula():
+    """Tests min_lengths: the shortest canonical formula over {a} is 'a'."""
+    grammar = build_grammar(Syntax(aps=("a",))).grammar
+    assert grammar.min_lengths()["root"] == 1
+
+
+def test_grammar_needs_propositions():
+    """Tests that a grammar is built per request, from its propositions."""
+    with pytest.raises(ConfigError, match="give aps"):
+        build_grammar(Syntax())

@@ -1,0 +1,104 @@
+"""Spot checks: hand-checked verdicts, the direction of implication, bounded until."""
+
+import random
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ara.errors import BoundTooLargeError
+from ara.grammars import Interval, Until, parse
+from ara.grammars.semantics import Lasso, holds
+from ara.grammars.spot_bridge import (
+    SPOT_MAX_BOUND,
+    accepts_word,
+    equivalent,
+    implies,
+    to_spot_text,
+)
+
+
+@pytest.mark.parametrize(
+    ("a", "b", "expected"),
+    [
+        ("F(a | F(b))", "F(a) | F(b)", True),  # F distributes over |, FF = F
+        ("G(a & b)", "G(a) & G(b)", True),  # G distributes over &
+        ("!F(a)", "G(!a)", True),  # duality
+        ("a -> b", "!a | b", True),
+        ("G(!a | b)", "G(!a) | b", False),  # NL2TL's noisy pair: not the same
+        ("F(a)", "G(a)", False),
+        ("F[0,3](a)", "a | X(a) | X(X(a)) | X(X(X(a)))", True),  # bounded F unrolls
+        ("G[1,2](a)", "X(a) & X(X(a))", True),
+        ("F[2,5](a)", "F[2,6](a)", False),
+        ("a U[0,inf] b", "a U b", True),  # [0,inf] is the untimed operator
+    ],
+)
+def test_equivalent_on_hand_checked_pairs(a, b, expected):
+    """Tests equivalence verdicts worked out by hand."""
+    assert equivalent(parse(a), parse(b)) is expected
+
+
+@pytest.mark.parametrize(
+    ("a", "b", "a_implies_b", "b_implies_a"),
+    [
+        ("G(a)", "F(a)", True, False),  # always implies eventually, not back
+        ("a & b", "a", True, False),
+        ("F(a)", "F(a) | F(b)", True, False),
+        ("F[2,3](a)", "F[1,5](a)", True, False),  # a tighter window implies a wider one
+        ("G[1,5](a)", "G[2,3](a)", True, False),
+        ("F(a)", "G(b)", False, False),  # unrelated
+        ("a U b", "F(b)", True, False),  # strong until promises b
+    ],
+)
+def test_implies_follows_the_direction_of_the_arrow(a, b, a_implies_b, b_implies_a):
+    """Tests implies(A, B) means A => B (spot.contains takes its arguments the other way)."""
+    fa, fb = parse(a), parse(b)
+    assert implies(fa, fb) is a_implies_b
+    assert implies(fb, fa) is b_implies_a
+
+
+def test_propositions_that_look_like_operators_are_quoted():
+    """Tests that 'Fa' and 'X1' stay propositions in Spot instead of F(a) or X(1)."""
+    assert to_spot_text(parse("Fa & X1")) == '("Fa" & "X1")'
+    assert not equivalent(parse("Fa"), parse("F(a)"))
+
+
+def test_bounds_past_the_limit_raise_a_clear_error():
+    """Tests that a huge bound fails fast with BoundTooLargeError naming the limit."""
+    big = parse(f"F[0,{SPOT_MAX_BOUND + 1}](a)")
+    with pytest.raises(BoundTooLargeError, match="SPOT_MAX_BOUND"):
+        equivalent(big, parse("F(a)"))
+    with pytest.raises(BoundTooLargeError):
+        implies(parse("a"), big)
+
+
+letters = st.frozensets(st.sampled_from(["a", "b"]))
+lassos = st.builds(Lasso, st.lists(letters, max_size=5).map(tuple),
+                   st.lists(letters, min_size=1, max_size=3).map(tuple))
+operands = st.sampled_from(["a", "!a", "a | b", "true", "F(b)"]).map(parse)
+
+
+@settings(max_examples=150, deadline=None)
+@given(lhs=operands, rhs=st.sampled_from(["b", "a & b", "!b", "false"]).map(parse),
+       lo=st.integers(0, 4), width=st.integers(0, 4), unbounded=st.booleans(), word=lassos)
+def test_bounded_until_expansion_matches_brute_force(lhs, rhs, lo, width, unbounded, word):
+    """Tests Spot's expansion of p U[a,b] q against the definition on random lasso words."""
+    f = Until(lhs, rhs, Interval(lo, None if unbounded else lo + width))
+    assert accepts_word(f, list(word.prefix), list(word.loop), ("a", "b")) == holds(f, word)
+
+
+def test_brute_force_and_spot_agree_on_random_timed_formulas():
+    """Tests the whole translation (every operator) against the brute-force evaluator."""
+    from ara.grammars import Syntax, build_grammar
+
+    grammar = build_grammar(Syntax(aps=("a", "b"), intervals=True, max_bound=4,
+                                   allow_next=True, allow_inf=True, relaxed=True)).grammar
+    rng = random.Random(7)
+    for _ in range(60):
+        f = parse(grammar.sample(rng, budget=12))
+        for _ in range(3):
+            word = Lasso(tuple(frozenset(x for x in "ab" if rng.random() < 0.5)
+                               for _ in range(rng.randint(0, 4))),
+                         tuple(frozenset(x for x in "ab" if rng.random() < 0.5)
+                               for _ in range(rng.randint(1, 3))))
+            assert accepts_word(f, list(word.prefix), list(word.loop), ("a", "b")) == holds(f, word)

@@ -1,0 +1,94 @@
+"""The `ara` command line: the contract later work and external checks rely on."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from ara.cli import app
+
+ARA = [str(Path(sys.executable).with_name("ara"))]
+runner = CliRunner()
+
+
+def ara(*args, **kwargs):
+    """Run the installed `ara` entry point for real."""
+    return subprocess.run(ARA + list(args), capture_output=True, text=True, timeout=300, **kwargs)
+
+
+def test_parse_prints_canonical_form():
+    """Tests `ara stl parse` on the paper's style, as text and as JSON."""
+    out = ara("stl", "parse", "F(a) & G[0,30](~b) -> c U[2,5] d")
+    assert out.returncode == 0 and out.stdout == "(F(a) & G[0,30](!b)) -> (c U[2,5] d)\n"
+    out = ara("stl", "parse", "F a", "--json")
+    assert json.loads(out.stdout) == {"stl": "F(a)", "valid": True}
+
+
+def test_invalid_formula_exits_2_naming_the_position():
+    """Tests the exit code and message for a syntax error."""
+    out = ara("stl", "parse", "F(a & ")
+    assert out.returncode == 2
+    assert "at position 6" in out.stderr and "found end of input" in out.stderr
+
+
+@pytest.mark.parametrize(
+    ("command", "a", "b", "key", "expected"),
+    [
+        ("equiv", "F(a | F(b))", "F(a) | F(b)", "equivalent", True),
+        ("equiv", "F(a)", "G(a)", "equivalent", False),
+        ("implies", "G(a)", "F(a)", "implies", True),  # A => B
+        ("implies", "F(a)", "G(a)", "implies", False),  # and not back
+    ],
+)
+def test_equiv_and_implies_print_one_json_object(command, a, b, key, expected):
+    """Tests `ara stl equiv|implies A B --json`."""
+    out = ara("stl", command, a, b, "--json")
+    assert out.returncode == 0 and json.loads(out.stdout) == {key: expected}
+
+
+def test_grammar_output_loads_in_llama_cpp_and_lark():
+    """Tests that `ara grammar` prints GBNF llama.cpp accepts and Lark that lark accepts."""
+    import lark
+
+    gbnf = ara("grammar", "--aps", "a,b,c", "--intervals", "--max-bound", "20").stdout
+    lark_text = ara("grammar", "--aps", "a,b,c", "--format", "lark", "--relaxed").stdout
+    assert gbnf.startswith("# ara grammar 1.0.0 sha256:") and "root ::= " in gbnf
+    parser = lark.Lark(lark_text, start="start", parser="earley", lexer="dynamic")
+    parser.parse("F a & G !b")
+    pytest.importorskip("llama_cpp", reason="needs llama-cpp-python (make setup)")
+    from ara.grammars.llama_check import LlamaGrammarChecker
+
+    checker = LlamaGrammarChecker(gbnf)
+    assert checker.accepts("F[2,5](a) & G(!b)") and not checker.accepts("F[2,25](a)")
+
+
+def test_grammar_with_bad_propositions_exits_2():
+    """Tests that a reserved word as a proposition is refused with the rule."""
+    out = ara("grammar", "--aps", "a,F")
+    assert out.returncode == 2 and "'F' is not a valid name" in out.stderr
+
+
+def test_data_prepare_and_stats(tmp_path):
+    """Tests `ara data prepare` then `ara data stats --json` on a fresh root."""
+    out = ara("data", "prepare", "--split", "timed", "--root", str(tmp_path))
+    assert out.returncode == 0 and "timed-" in out.stdout and "0 raw rows rejected" in out.stdout
+    out = ara("data", "stats", "--split", "timed", "--root", str(tmp_path), "--json")
+    stats = json.loads(out.stdout)
+    assert stats["train"] == 6648 and stats["test"] == 1425 and stats["form"] == "lifted"
+    out = ara("data", "stats", "--split", "paper", "--root", str(tmp_path))
+    assert out.returncode == 2 and "ara data prepare --split paper --seed 0" in out.stderr
+
+
+@pytest.mark.parametrize(
+    "command",
+    [[], ["stl"], ["stl", "parse"], ["stl", "equiv"], ["stl", "implies"], ["grammar"],
+     ["data"], ["data", "prepare"], ["data", "stats"], ["data", "export"], ["demo"]],
+)
+def test_every_command_explains_itself(command):
+    """Tests that --help works everywhere and says something."""
+    result = runner.invoke(app, command + ["--help"], env={**os.environ, "COLUMNS": "120"})
+    assert result.exit_code == 0 and "Usage" in result.output and len(result.output) > 200
