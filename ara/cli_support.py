@@ -14,13 +14,18 @@ from ara.errors import AraError
 
 #: Exit code for bad input (invalid formula, unknown option value, missing data).
 EXIT_BAD_INPUT = 2
+#: Exit code for a check that ran out of time (the answer is unknown, not no).
+EXIT_UNDECIDED = 3
 
 
 @contextmanager
 def user_errors() -> Iterator[None]:
-    """Print a toolkit error as ``error: ...`` on stderr and exit with code 2."""
+    """Print a toolkit error as ``error: ...`` on stderr and exit with code 2 (3 on timeout)."""
     try:
         yield
+    except TimeoutError as err:
+        typer.echo(f"undecided: {err}", err=True)
+        raise typer.Exit(EXIT_UNDECIDED) from None
     except AraError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None

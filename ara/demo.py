@@ -9,6 +9,7 @@ and Spot's verdicts between the pairs.
 from __future__ import annotations
 
 import random
+from itertools import pairwise
 
 import typer
 
@@ -34,7 +35,7 @@ def demo_cmd(
     test = prepare("paper", 0).records("test")
     picks = random.Random(seed).sample(test, n)
 
-    typer.echo("\n== grammar + parse: each pair's formula under the grammar of its own propositions")
+    typer.echo("\n== grammar + parse: each formula under the grammar of its own propositions")
     for r in picks:
         syntax = Syntax(aps=r.aps)
         built = build_grammar(syntax)
@@ -47,7 +48,7 @@ def demo_cmd(
     typer.echo("\n== Spot: equivalence and implication between the lifted formulas")
     lifted = [r for r in prepare("paper", 0).records("test", "lifted")]
     sample = random.Random(seed + 1).sample(lifted, 6)
-    for a, b in zip(sample, sample[1:]):
+    for a, b in pairwise(sample):
         fa, fb = parse(a.stl), parse(b.stl)
         typer.echo(f"  {a.stl:<32} vs {b.stl:<32} equivalent={equivalent(fa, fb)!s:<5} "
                    f"A=>B={implies(fa, fb)!s:<5} B=>A={implies(fb, fa)}")

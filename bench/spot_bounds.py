@@ -18,7 +18,8 @@ import time
 SHAPES = {
     "F[b/2,b] & G[0,b] vs U[b/3,b]": ("F[{h},{b}](a) & G[0,{b}](b)", "a U[{t},{b}] b"),
     "G(a -> F[b/2,b] G c)": ("G(a -> F[{h},{b}](G(c)))", "G(a -> F[{h},{b}](G(c))) & F[0,{b}](b)"),
-    "G[b/4,b/2](!a) U[b/2,b] b": ("G[{q},{h}](!a) U[{h},{b}] b", "G[{q},{h}](!a) U[{h},{b}] (b & c)"),
+    "G[b/4,b/2](!a) U[b/2,b] b": ("G[{q},{h}](!a) U[{h},{b}] b",
+                                  "G[{q},{h}](!a) U[{h},{b}] (b & c)"),
     "F[b/2,b](a -> b) -> c": ("F[{h},{b}](a -> b) -> c", "F[{q},{b}](a -> b) -> c"),
 }
 
@@ -51,7 +52,8 @@ def main() -> None:
     args = ap.parse_args()
     bounds = [int(x) for x in args.bounds.split(",")]
     print(f"# Spot equivalence time (s) by bound b; '>{args.limit_s:g}' = killed at the limit")
-    print(f"# machine: {platform.machine()}, {mp.cpu_count()} cores, python {platform.python_version()}")
+    print(f"# machine: {platform.machine()}, {mp.cpu_count()} cores, "
+          f"python {platform.python_version()}")
     print("| shape | " + " | ".join(f"b={b}" for b in bounds) + " |")
     print("|---|" + "---|" * len(bounds))
     for name, (a, b_) in SHAPES.items():

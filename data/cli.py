@@ -31,8 +31,8 @@ def prepare_cmd(
         with user_errors():
             prepared = prepare(name, seed, root)
         m = prepared.manifest
-        emit(m, as_json, lambda m: (
-            f"{prepared.folder}  version {m['version']}: "
+        emit(m, as_json, lambda m, folder=prepared.folder: (
+            f"{folder}  version {m['version']}: "
             + ", ".join(f"{p} {sum(c.values())} records" for p, c in m["counts"].items())
             + f"; {m['rejected']['count']} raw rows rejected"
             + "".join(f"\n    rejected row {e['row']}: {e['text']!r}: {e['error']}"

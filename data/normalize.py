@@ -161,5 +161,6 @@ def normalize_timed(rows: list[dict], source: str = "nl2tl_timed",
         except ValueError as err:
             rejected.append(RejectedRow(source, i, "lifted", text, str(err).splitlines()[0]))
             continue
-        records.append(_record(uid, source, "lifted", i, detokenize(row["logic_sentence"]), formula))
+        nl = detokenize(row["logic_sentence"])
+        records.append(_record(uid, source, "lifted", i, nl, formula))
     return records, rejected

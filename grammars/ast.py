@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
-from typing import Union
 
 from ara.errors import AraError
 
@@ -152,7 +151,7 @@ class Until:
     interval: Interval | None = None
 
 
-Formula = Union[Atom, Const, Not, And, Or, Implies, Iff, Eventually, Always, Next, Until]
+Formula = Atom | Const | Not | And | Or | Implies | Iff | Eventually | Always | Next | Until
 BINARY = (And, Or, Implies, Iff, Until)
 TEMPORAL_UNARY = (Eventually, Always, Next)
 

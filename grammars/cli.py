@@ -18,6 +18,9 @@ stl_app = typer.Typer(
 )
 
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object instead of text.")
+TIMEOUT_OPT = typer.Option(
+    60.0, "--timeout", help="Seconds Spot may take; past it, exit 3 (undecided)."
+)
 
 
 @stl_app.command("parse")
@@ -36,12 +39,13 @@ def equiv_cmd(
     a: str = typer.Argument(..., help="First formula."),
     b: str = typer.Argument(..., help="Second formula."),
     as_json: bool = JSON_OPT,
+    timeout: float = TIMEOUT_OPT,
 ) -> None:
     """Whether A and B hold on exactly the same traces (decided by Spot)."""
     from ara.grammars.spot_bridge import equivalent
 
     with user_errors():
-        result = equivalent(parse(a), parse(b))
+        result = equivalent(parse(a), parse(b), timeout_s=timeout)
     emit({"equivalent": result}, as_json, lambda v: "equivalent" if result else "not equivalent")
 
 
@@ -50,12 +54,13 @@ def implies_cmd(
     a: str = typer.Argument(..., help="Premise."),
     b: str = typer.Argument(..., help="Conclusion."),
     as_json: bool = JSON_OPT,
+    timeout: float = TIMEOUT_OPT,
 ) -> None:
     """Whether A implies B: every trace satisfying A satisfies B (decided by Spot)."""
     from ara.grammars.spot_bridge import implies
 
     with user_errors():
-        result = implies(parse(a), parse(b))
+        result = implies(parse(a), parse(b), timeout_s=timeout)
     emit({"implies": result}, as_json, lambda v: "A implies B" if result else "A does not imply B")
 
 
@@ -66,7 +71,9 @@ class GrammarFormat(str, Enum):
 
 def grammar_cmd(
     aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, e.g. a,b,c."),
-    intervals: bool = typer.Option(False, "--intervals", help="Allow F[lo,hi], G[lo,hi], U[lo,hi]."),
+    intervals: bool = typer.Option(
+        False, "--intervals", help="Allow F[lo,hi], G[lo,hi], U[lo,hi]."
+    ),
     max_bound: int = typer.Option(1000, "--max-bound", help="Largest time bound in an interval."),
     allow_inf: bool = typer.Option(False, "--allow-inf", help="Allow [lo,inf] intervals."),
     allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),

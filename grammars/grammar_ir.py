@@ -13,7 +13,6 @@ import hashlib
 import math
 import random
 from dataclasses import dataclass
-from typing import Union
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,7 +53,7 @@ class Star:
     items: tuple[Item, ...]
 
 
-Item = Union[Lit, Chars, Ref, Opt, Star]
+Item = Lit | Chars | Ref | Opt | Star
 Seq = tuple[Item, ...]
 
 
@@ -154,7 +153,7 @@ class Grammar:
                 alts = rules[item.name].alts
                 if state["left"] <= 0:
                     lengths = [seq_len(a) for a in alts]
-                    alts = tuple(a for a, n in zip(alts, lengths) if n == min(lengths))
+                    alts = tuple(a for a, n in zip(alts, lengths, strict=True) if n == min(lengths))
                 expand_seq(rng.choice(alts))
 
         expand(Ref(self.root))

@@ -21,11 +21,25 @@ class GBNFError(AraError, ValueError):
     """A GBNF text that llama.cpp refuses to load."""
 
 
+# The ctypes callback must outlive every call into llama.cpp, so it lives here.
+_silent_log = None
+
+
 @lru_cache(maxsize=4)
 def _vocab_model(model_path: str):
     import llama_cpp
+    from llama_cpp import _logger
 
-    return llama_cpp.Llama(model_path=model_path, vocab_only=True, verbose=False)
+    global _silent_log
+    if _silent_log is None:
+        _silent_log = llama_cpp.llama_log_callback(lambda level, text, user_data: None)
+    # A vocab-only model still gets a context, and llama.cpp logs an error-level
+    # complaint about its size (n_ctx_train is 0 without weights); mute just that load.
+    llama_cpp.llama_log_set(_silent_log, ctypes.c_void_p(0))
+    try:
+        return llama_cpp.Llama(model_path=model_path, vocab_only=True, verbose=False)
+    finally:
+        llama_cpp.llama_log_set(_logger.llama_log_callback, ctypes.c_void_p(0))
 
 
 # Free cached models while llama_cpp is still importable; left to interpreter

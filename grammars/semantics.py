@@ -9,7 +9,7 @@ independent reference for the Spot translation, bounded until included.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 from ara.grammars.ast import (
     Always,
@@ -63,7 +63,7 @@ def holds(formula: Formula, word: Lasso, t: int = 0) -> bool:
     return _holds(formula, word, word.fold(t))
 
 
-@lru_cache(maxsize=None)
+@cache
 def _holds(f: Formula, w: Lasso, t: int) -> bool:
     # Steps past t + period repeat ones already seen, so an unbounded search for a
     # witness may stop there.

@@ -20,9 +20,10 @@ with :class:`~ara.errors.BoundTooLargeError` rather than left to run for minutes
 
 from __future__ import annotations
 
+import multiprocessing
 from functools import lru_cache
 
-from ara.errors import BoundTooLargeError
+from ara.errors import AraError, BoundTooLargeError
 from ara.grammars.ast import (
     Always,
     And,
@@ -42,7 +43,9 @@ from ara.grammars.ast import (
 from ara.grammars.printer import to_text
 
 #: Largest interval bound the Spot checks accept (see ``bench/spot_bounds.py``).
-SPOT_MAX_BOUND = 256
+SPOT_MAX_BOUND = 1000
+#: Spot's own limit on ``X[n]``, ``F[a..b]``, ``G[a..b]``; larger bounds are chained.
+SPOT_MAX_REPEAT = 254
 
 
 def to_spot_text(formula: Formula) -> str:
@@ -67,17 +70,37 @@ def to_spot_text(formula: Formula) -> str:
         return f"X({to_spot_text(formula.arg)})"
     if isinstance(formula, (Eventually, Always)):
         op = "F" if isinstance(formula, Eventually) else "G"
-        return f"{op}{_spot_interval(formula.interval)}({to_spot_text(formula.arg)})"
+        arg = to_spot_text(formula.arg)
+        if formula.interval is None:
+            return f"{op}({arg})"
+        return _bounded(op, formula.interval.lo, formula.interval.hi, arg)
     if isinstance(formula, Until):
         return _until_text(formula.lhs, formula.rhs, formula.interval)
     raise TypeError(f"not a formula node: {formula!r}")
 
 
-def _spot_interval(interval: Interval | None) -> str:
-    if interval is None:
-        return ""
-    hi = "" if interval.hi is None else str(interval.hi)
-    return f"[{interval.lo}..{hi}]"
+def _next(n: int, f: str) -> str:
+    """``X^n f``, chained in pieces Spot accepts (it refuses repetitions above 254)."""
+    while n > SPOT_MAX_REPEAT:
+        f, n = f"X[{SPOT_MAX_REPEAT}]({f})", n - SPOT_MAX_REPEAT
+    return f"X[{n}]({f})" if n else f
+
+
+def _bounded(op: str, lo: int, hi: int | None, f: str) -> str:
+    """``F[lo,hi] f`` or ``G[lo,hi] f`` with Spot's operators, any bound size.
+
+    Past Spot's repetition limit the window is shifted with ``X`` and split:
+    ``F[lo,hi] f = F[lo,254] f | X^255 F[0,hi-255] f`` (``&`` for ``G``).
+    """
+    if hi is None:
+        return _next(lo, f"{op}({f})")
+    if lo > SPOT_MAX_REPEAT:
+        return _next(lo, _bounded(op, 0, hi - lo, f))
+    if hi <= SPOT_MAX_REPEAT:
+        return f"{op}[{lo}..{hi}]({f})"
+    join = " | " if op == "F" else " & "
+    rest = _next(SPOT_MAX_REPEAT + 1, _bounded(op, 0, hi - SPOT_MAX_REPEAT - 1, f))
+    return f"({op}[{lo}..{SPOT_MAX_REPEAT}]({f}){join}{rest})"
 
 
 def _until_text(lhs: Formula, rhs: Formula, interval: Interval | None) -> str:
@@ -88,10 +111,10 @@ def _until_text(lhs: Formula, rhs: Formula, interval: Interval | None) -> str:
     a, b = interval.lo, interval.hi
     parts = []
     if a > 0:
-        parts.append(f"G[0..{a - 1}]({p})")
+        parts.append(_bounded("G", 0, a - 1, p))
     if b is not None:
-        parts.append(f"F[{a}..{b}]({q})")
-    parts.append(f"X[{a}]{untimed}" if a > 0 else untimed)
+        parts.append(_bounded("F", a, b, q))
+    parts.append(_next(a, untimed))
     return "(" + " & ".join(parts) + ")"
 
 
@@ -124,20 +147,88 @@ def _spot_formula(text: str):
     return spot.formula(text)
 
 
-def equivalent(a: Formula, b: Formula) -> bool:
-    """Whether ``a`` and ``b`` hold on exactly the same (infinite, discrete-time) traces."""
+class SpotTimeoutError(AraError, TimeoutError):
+    """A Spot check that did not finish within its time limit."""
+
+
+def equivalent(a: Formula, b: Formula, timeout_s: float | None = None) -> bool:
+    """Whether ``a`` and ``b`` hold on exactly the same (infinite, discrete-time) traces.
+
+    Args:
+        a: First formula.
+        b: Second formula.
+        timeout_s: Time limit in seconds; ``None`` decides in this process, however
+            long it takes. Some shapes are exponential in the window width under
+            ``G`` (``G(a -> F[8,16] G(c))`` takes seconds), so pass a limit when the
+            formulas come from a model.
+
+    Raises:
+        BoundTooLargeError: If an interval bound exceeds :data:`SPOT_MAX_BOUND`.
+        SpotTimeoutError: If ``timeout_s`` passed first.
+    """
     _check_bounds(a, b)
-    return _equivalent(to_spot_text(a), to_spot_text(b))
+    return _decide("equivalent", to_spot_text(a), to_spot_text(b), timeout_s)
 
 
-def implies(a: Formula, b: Formula) -> bool:
+def implies(a: Formula, b: Formula, timeout_s: float | None = None) -> bool:
     """Whether every trace satisfying ``a`` satisfies ``b`` (``a => b``).
 
     ``spot.contains(x, y)`` asks whether the language of ``y`` is contained in that
-    of ``x``, so ``a => b`` is ``spot.contains(b, a)``.
+    of ``x``, so ``a => b`` is ``spot.contains(b, a)``. Arguments and errors as in
+    :func:`equivalent`.
     """
     _check_bounds(a, b)
-    return _implies(to_spot_text(a), to_spot_text(b))
+    return _decide("implies", to_spot_text(a), to_spot_text(b), timeout_s)
+
+
+def _decide(op: str, a: str, b: str, timeout_s: float | None) -> bool:
+    if timeout_s is None:
+        return (_equivalent if op == "equivalent" else _implies)(a, b)
+    return _Worker.get().ask(op, a, b, timeout_s)
+
+
+class _Worker:
+    """A Spot process that can be killed when a check runs past its limit.
+
+    Spot's C++ cannot be interrupted from Python, so limited checks run here; on a
+    timeout the process is killed and replaced (about half a second).
+    """
+
+    _instance: _Worker | None = None
+
+    def __init__(self) -> None:
+        ctx = multiprocessing.get_context("spawn")  # no fork: the parent may hold threads
+        self.conn, child = ctx.Pipe()
+        self.proc = ctx.Process(target=_serve, args=(child,), daemon=True)
+        self.proc.start()
+        self.cache: dict[tuple[str, str, str], bool] = {}
+
+    @classmethod
+    def get(cls) -> _Worker:
+        if cls._instance is None or not cls._instance.proc.is_alive():
+            cls._instance = cls()
+        return cls._instance
+
+    def ask(self, op: str, a: str, b: str, timeout_s: float) -> bool:
+        key = (op, a, b)
+        if key not in self.cache:
+            self.conn.send(key)
+            if not self.conn.poll(timeout_s):
+                self.proc.kill()
+                self.proc.join()
+                _Worker._instance = None
+                raise SpotTimeoutError(
+                    f"Spot did not decide {op}({a}, {b}) within {timeout_s:g} s; the check "
+                    "is exponential in the width of windows nested under G"
+                )
+            self.cache[key] = self.conn.recv()
+        return self.cache[key]
+
+
+def _serve(conn) -> None:
+    while True:
+        op, a, b = conn.recv()
+        conn.send(_equivalent(a, b) if op == "equivalent" else _implies(a, b))
 
 
 @lru_cache(maxsize=65536)

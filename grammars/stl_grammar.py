@@ -18,6 +18,10 @@ from ara.grammars.syntax import GRAMMAR_VERSION, Syntax
 
 _DIGIT = Chars((("0", "9"),))
 
+#: Largest ``max_bound`` a grammar is built for: the interval trie holds about two rules
+#: per number up to the bound, and 10,000 already makes a ~1.5 MB grammar.
+MAX_GRAMMAR_BOUND = 10_000
+
 
 @dataclass(frozen=True)
 class BuiltGrammar:
@@ -47,7 +51,8 @@ def build_grammar(syntax: Syntax) -> BuiltGrammar:
     """Build the grammar whose language is exactly ``syntax``'s.
 
     Raises:
-        ConfigError: If ``syntax.aps`` is ``None``.
+        ConfigError: If ``syntax.aps`` is ``None``, or intervals are on with
+            ``max_bound`` above :data:`MAX_GRAMMAR_BOUND`.
     """
     return _build_cached(syntax)
 
@@ -58,6 +63,12 @@ def _build_cached(syntax: Syntax) -> BuiltGrammar:
         raise ConfigError(
             "a grammar is built per request from its atomic propositions: give aps, "
             "e.g. Syntax(aps=('prop_1', 'prop_2'))"
+        )
+    if syntax.intervals and syntax.max_bound > MAX_GRAMMAR_BOUND:
+        raise ConfigError(
+            f"max_bound={syntax.max_bound} would make a grammar of ~{2 * syntax.max_bound:,} "
+            f"rules; grammars are built up to max_bound={MAX_GRAMMAR_BOUND:,}. Rescale the "
+            "time unit (e.g. seconds instead of steps)"
         )
     # Longest names first keeps the emitted alternatives readable; order has no
     # effect on the language.

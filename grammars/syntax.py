@@ -21,6 +21,7 @@ Two layouts:
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from itertools import pairwise
 
 from ara.errors import ConfigError, STLSyntaxError
 from ara.grammars.ast import KEYWORDS, And, Formula, Or, depth, is_identifier, walk
@@ -111,8 +112,8 @@ class Syntax:
         else:
             canonical = to_text(formula)
             if canonical != text:
-                at = next((i for i, (a, b) in enumerate(zip(text, canonical)) if a != b),
-                          min(len(text), len(canonical)))
+                pairs = enumerate(zip(text, canonical, strict=False))
+                at = next((i for i, (a, b) in pairs if a != b), min(len(text), len(canonical)))
                 raise STLSyntaxError(text, at, f"not in canonical form {canonical!r}")
             self._check_shape(text, formula)
         return formula
@@ -130,12 +131,16 @@ class Syntax:
             elif tok.text == "[" and not self.intervals:
                 raise STLSyntaxError(text, tok.start, "intervals are not allowed in this language")
             elif tok.text == "inf" and not self.allow_inf:
-                raise STLSyntaxError(text, tok.start, "unbounded intervals [lo,inf] are not allowed")
+                raise STLSyntaxError(
+                    text, tok.start, "unbounded intervals [lo,inf] are not allowed"
+                )
             elif tok.text == "X" and not self.allow_next:
                 raise STLSyntaxError(text, tok.start, "the next operator X is not allowed")
             elif tok.kind is Kind.NUMBER:
                 if tok.text != str(int(tok.text)):
-                    raise STLSyntaxError(text, tok.start, f"write {int(tok.text)}, without leading zeros")
+                    raise STLSyntaxError(
+                        text, tok.start, f"write {int(tok.text)}, without leading zeros"
+                    )
                 if int(tok.text) > self.max_bound:
                     raise STLSyntaxError(
                         text, tok.start, f"time bound {tok.text} exceeds max_bound={self.max_bound}"
@@ -147,7 +152,8 @@ class Syntax:
                 text, 0, f"nesting depth {depth(formula)} exceeds max_depth={self.max_depth}"
             )
         if self.max_args is not None:
-            widest = max((len(n.args) for n in walk(formula) if isinstance(n, (And, Or))), default=0)
+            nary = (len(n.args) for n in walk(formula) if isinstance(n, (And, Or)))
+            widest = max(nary, default=0)
             if widest > self.max_args:
                 raise STLSyntaxError(
                     text, 0, f"an & or | with {widest} arguments exceeds max_args={self.max_args}"
@@ -160,7 +166,7 @@ def _check_relaxed_layout(text: str, tokens: list[Token]) -> None:
         raise STLSyntaxError(text, 0, "no whitespace is allowed before the formula")
     in_interval = False
     after_until = False  # inside or right after U's interval, the next gap must be " "
-    for prev, tok in zip(tokens, tokens[1:]):
+    for prev, tok in pairwise(tokens):
         gap, at = tok.space, tok.start - len(tok.space)
         if tok.kind is Kind.END:
             if gap:

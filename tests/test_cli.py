@@ -50,6 +50,13 @@ def test_equiv_and_implies_print_one_json_object(command, a, b, key, expected):
     assert out.returncode == 0 and json.loads(out.stdout) == {key: expected}
 
 
+def test_a_check_past_its_time_limit_exits_3():
+    """Tests that an undecided Spot check is reported as such, not as false."""
+    out = ara("stl", "equiv", "G(a -> F[20,40](G(c)))", "G(a -> F[20,40](G(c))) & F[0,40](b)",
+              "--timeout", "1")
+    assert out.returncode == 3 and "undecided" in out.stderr and out.stdout == ""
+
+
 def test_grammar_output_loads_in_llama_cpp_and_lark():
     """Tests that `ara grammar` prints GBNF llama.cpp accepts and Lark that lark accepts."""
     import lark

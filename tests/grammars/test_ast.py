@@ -26,7 +26,8 @@ def test_bad_nodes_are_refused(build, message):
 
 def test_helpers_read_the_tree():
     """Tests atoms, depth and max_bound on one formula."""
-    f = And((Eventually(Atom("a"), Interval(2, 9)), Not(Until(Atom("b"), Atom("a"), Interval(0, 4)))))
+    until = Until(Atom("b"), Atom("a"), Interval(0, 4))
+    f = And((Eventually(Atom("a"), Interval(2, 9)), Not(until)))
     assert atoms(f) == {"a", "b"}
     assert depth(f) == 3
     assert max_bound(f) == 9

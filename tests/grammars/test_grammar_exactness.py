@@ -13,9 +13,10 @@ import lark
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from conftest import formulas
 
 from ara.grammars import Syntax, build_grammar, to_text
+
+from conftest import formulas
 
 # Each layout the grammar builder can emit, with a small bound so tests stay fast.
 SYNTAXES = {
@@ -154,7 +155,7 @@ def test_no_rule_is_left_recursive():
     for syntax in SYNTAXES.values():
         rules = build_grammar(syntax).grammar.by_name
 
-        def first_refs(name):
+        def first_refs(name, rules=rules):
             out = set()
             for seq in rules[name].alts:
                 for item in seq:

@@ -13,7 +13,7 @@ from ara.grammars.stl_grammar import number_patterns
 def _matches(pattern, text):
     if len(pattern) != len(text):
         return False
-    for item, ch in zip(pattern, text):
+    for item, ch in zip(pattern, text, strict=True):
         if isinstance(item, Lit) and item.text != ch:
             return False
         if isinstance(item, Chars) and ch not in item.members():
@@ -54,6 +54,12 @@ def test_min_length_is_the_shortest_formula():
     """Tests min_lengths: the shortest canonical formula over {a} is 'a'."""
     grammar = build_grammar(Syntax(aps=("a",))).grammar
     assert grammar.min_lengths()["root"] == 1
+
+
+def test_huge_bounds_are_refused_before_building():
+    """Tests that an interval bound past MAX_GRAMMAR_BOUND fails fast with the fix."""
+    with pytest.raises(ConfigError, match="Rescale the time unit"):
+        build_grammar(Syntax(aps=("a",), intervals=True, max_bound=10**7))
 
 
 def test_grammar_needs_propositions():

@@ -2,7 +2,6 @@
 
 import pytest
 from hypothesis import given, settings
-from conftest import formulas
 
 from ara.errors import STLSyntaxError
 from ara.grammars import (
@@ -19,6 +18,8 @@ from ara.grammars import (
     parse,
     to_text,
 )
+
+from conftest import formulas
 
 a, b, c, d = Atom("a"), Atom("b"), Atom("c"), Atom("d")
 

@@ -102,3 +102,28 @@ def test_brute_force_and_spot_agree_on_random_timed_formulas():
                          tuple(frozenset(x for x in "ab" if rng.random() < 0.5)
                                for _ in range(rng.randint(1, 3))))
             assert accepts_word(f, list(word.prefix), list(word.loop), ("a", "b")) == holds(f, word)
+
+
+@pytest.mark.parametrize("text", ["F[250,520](a)", "G[200,300](!a)", "b U[240,260] a",
+                                  "F[600,inf](a)", "G[0,254](!a)"])
+def test_bounds_past_spots_repetition_limit_stay_exact(text):
+    """Tests the chained encoding of bounds above 254 against brute force, at the seams."""
+    f = parse(text)
+    for k in (0, 199, 200, 239, 240, 249, 250, 254, 255, 256, 260, 261, 300, 301, 520, 521, 600):
+        # 'a' holds only at step k, 'b' before it
+        word = Lasso(tuple(frozenset("b") for _ in range(k)) + (frozenset("a"),),
+                     (frozenset(),))
+        assert accepts_word(f, list(word.prefix), list(word.loop), ("a", "b")) == holds(f, word), k
+
+
+def test_a_time_limit_turns_a_runaway_check_into_an_error():
+    """Tests SpotTimeoutError on a shape exponential in its window, then recovery."""
+    from ara.grammars.spot_bridge import SpotTimeoutError
+
+    slow_a = parse("G(a -> F[20,40](G(c)))")
+    slow_b = parse("G(a -> F[20,40](G(c))) & F[0,40](b)")
+    with pytest.raises(SpotTimeoutError, match="within 1 s"):
+        equivalent(slow_a, slow_b, timeout_s=1)
+    # the worker is replaced and answers the next check
+    assert implies(parse("G(a)"), parse("F(a)"), timeout_s=30) is True
+    assert equivalent(parse("F(a | F(b))"), parse("F(a) | F(b)"), timeout_s=30) is True
