@@ -7,6 +7,7 @@ import typer
 from ara import __version__
 from ara.data.cli import data_app
 from ara.demo import demo_cmd
+from ara.eval.cli import eval_app, translate_cmd
 from ara.grammars.cli import grammar_cmd, stl_app
 
 app = typer.Typer(
@@ -17,6 +18,8 @@ app = typer.Typer(
 )
 app.add_typer(stl_app, name="stl")
 app.add_typer(data_app, name="data")
+app.add_typer(eval_app, name="eval")
+app.command("translate")(translate_cmd)
 app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)
 

@@ -1,9 +1,9 @@
 """``ara demo``: the toolkit end to end on the embedded defaults.
 
-For now (the translator lands with its own issue): prepare the versioned splits, then
-for a few test pairs show the formula, the grammar built from the pair's own
-propositions, whether llama.cpp's grammar engine and Lark both admit the formula,
-and Spot's verdicts between the pairs.
+Prepare the versioned splits; for a few test pairs show the formula, the grammar built
+from the pair's own propositions, and whether llama.cpp's grammar engine and Lark both
+admit it; Spot's verdicts between pairs; then translate a few test sentences with the
+embedded Gemma 3 270M under the grammar and judge each answer against the reference.
 """
 
 from __future__ import annotations
@@ -17,8 +17,9 @@ import typer
 def demo_cmd(
     n: int = typer.Option(4, "--n", help="How many test pairs to show."),
     seed: int = typer.Option(0, "--seed", help="Which pairs: the sampling seed."),
+    model: str = typer.Option("default", "--model", help="Translator model (see ara translate)."),
 ) -> None:
-    """Prepare the data and show grammar, parse and Spot checks on a few test pairs."""
+    """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
     import lark
 
     from ara.data import prepare
@@ -55,6 +56,27 @@ def demo_cmd(
     noisy = ("F(prop_1 | F(prop_2))", "F(prop_1) | F(prop_2)")
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
+    _translate_some(model, n, seed)
+
+
+def _translate_some(model: str, n: int, seed: int) -> None:
+    from ara.data import prepare
+    from ara.eval.harness import judge
+    from ara.eval.models import make_backend
+    from ara.eval.prompt import sample_shots
+    from ara.eval.translator import Translator
+
+    split = prepare("paper", 0)
+    rng = random.Random(seed)
+    shots = sample_shots(split.records("train", "grounded"), 5, rng)
+    translator = Translator(make_backend(model))
+    typer.echo(f"\n== translate: {translator.backend.model_id}, 5 shots, grammar-constrained")
+    for r in rng.sample(split.records("test", "grounded"), n):
+        result = translator.translate(r.nl, r.aps, shots)
+        verdict = judge(r.stl, result.stl, timeout_s=10)
+        typer.echo(f"  {r.nl}\n      model {result.stl}   ({result.ms:.0f} ms)\n"
+                   f"      truth {r.stl}\n      equivalent={verdict['equivalent']} "
+                   f"model=>truth={verdict['implies']}")
 
 
 def _lark_accepts(lark, grammar_text: str, text: str) -> bool:

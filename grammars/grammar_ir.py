@@ -88,9 +88,21 @@ class Grammar:
     def by_name(self) -> dict[str, Rule]:
         return {r.name: r for r in self.rules}
 
+    def with_prefix(self, text: str) -> Grammar:
+        """The language ``text + w`` for each string ``w`` of this one.
+
+        Decoders use it for the space a model writes after ``"STL:"``, so that the
+        answer tokenizes as in training; the caller strips the prefix again.
+        """
+        name = self.root + "_prefixed"
+        while name in self.by_name:
+            name += "_"
+        rules = (Rule(name, ((Lit(text), Ref(self.root)),)), *self.rules)
+        return Grammar(rules, root=name)
+
     def to_gbnf(self) -> str:
         """The grammar in llama.cpp's GBNF; the start rule is named ``root``."""
-        name = {r.name: ("root" if r.name == self.root else r.name.replace("_", "-"))
+        name = {r.name: ("root" if r.name == self.root else _gbnf_name(r.name))
                 for r in self.rules}
         lines = []
         for rule in self.rules:
@@ -237,6 +249,12 @@ def _seq_text(seq: Seq, name: dict[str, str], lit, chars) -> str:
             inner = _seq_text(item.items, name, lit, chars)
             parts.append(f"({inner}){'?' if isinstance(item, Opt) else '*'}")
     return " ".join(parts) if parts else '""'
+
+
+def _gbnf_name(name: str) -> str:
+    # GBNF names take dashes, not underscores, and "root" is reserved for the start rule.
+    name = name.replace("_", "-")
+    return "root-rule" if name == "root" else name
 
 
 def _escape(text: str) -> str:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import atexit
 import ctypes
 import math
+from contextlib import contextmanager
 from functools import lru_cache
 
 from ara.errors import AraError
@@ -25,21 +26,32 @@ class GBNFError(AraError, ValueError):
 _silent_log = None
 
 
-@lru_cache(maxsize=4)
-def _vocab_model(model_path: str):
+@contextmanager
+def muted_llama_log():
+    """Silence llama.cpp's own log while loading a model.
+
+    llama-cpp-python's ``verbose=False`` leaves some load-time lines through (a
+    vocab-only model's context size complaint, the full-size SWA cache notice).
+    """
     import llama_cpp
     from llama_cpp import _logger
 
     global _silent_log
     if _silent_log is None:
         _silent_log = llama_cpp.llama_log_callback(lambda level, text, user_data: None)
-    # A vocab-only model still gets a context, and llama.cpp logs an error-level
-    # complaint about its size (n_ctx_train is 0 without weights); mute just that load.
     llama_cpp.llama_log_set(_silent_log, ctypes.c_void_p(0))
     try:
-        return llama_cpp.Llama(model_path=model_path, vocab_only=True, verbose=False)
+        yield
     finally:
         llama_cpp.llama_log_set(_logger.llama_log_callback, ctypes.c_void_p(0))
+
+
+@lru_cache(maxsize=4)
+def _vocab_model(model_path: str):
+    import llama_cpp
+
+    with muted_llama_log():
+        return llama_cpp.Llama(model_path=model_path, vocab_only=True, verbose=False)
 
 
 # Free cached models while llama_cpp is still importable; left to interpreter

@@ -23,13 +23,13 @@ pip() { "$VENV/bin/python" -m pip --disable-pip-version-check "$@"; }
 
 # torch first and pinned: on these machines torch==2.13.0 is a local CPU wheel, while any
 # range admitting newer releases would pull several GB of CUDA packages.
-pip install -q torch==2.13.0
+pip install -qq torch==2.13.0
 
 # A native build of llama.cpp uses AMX instructions that these CPUs advertise but refuse
 # (SIGILL); these flags keep it to AVX2/FMA/F16C.
 export CMAKE_ARGS="${CMAKE_ARGS:--DGGML_NATIVE=OFF -DGGML_AVX2=ON -DGGML_FMA=ON -DGGML_F16C=ON -DLLAVA_BUILD=OFF}"
 echo "setup: installing the toolkit (llama-cpp-python builds from source once, ~10-20 min)"
-pip install -q -e ".[all]"
+pip install -qq -e ".[all]"
 
 rm -f "$VENV"/.ara-setup-*
 touch "$stamp"

@@ -75,3 +75,22 @@ def embedded_model_path() -> str:
     from ara.grammars.llama_check import default_model_path
 
     return default_model_path()
+
+
+@pytest.fixture(scope="session")
+def llama_backend(embedded_model_path):
+    """The embedded Gemma 3 270M through llama.cpp, llguidance masks (loaded once)."""
+    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+
+    return LlamaCppBackend(embedded_model_path, n_ctx=4096)
+
+
+@pytest.fixture(scope="session")
+def paper_split():
+    """The registered paper split, prepared if this machine has not yet."""
+    from ara.data import load_split, prepare
+
+    try:
+        return load_split("paper")
+    except ValueError:
+        return prepare("paper")

@@ -66,3 +66,17 @@ def test_grammar_needs_propositions():
     """Tests that a grammar is built per request, from its propositions."""
     with pytest.raises(ConfigError, match="give aps"):
         build_grammar(Syntax())
+
+
+def test_with_prefix_adds_exactly_the_prefix():
+    """Tests the decoding grammar ' ' + formula in both emitted formats."""
+    import lark
+
+    grammar = build_grammar(Syntax(aps=("a", "b"))).grammar.with_prefix(" ")
+    gbnf = grammar.to_gbnf()
+    assert gbnf.count("root ::= ") == 1 and 'root ::= " " root-rule' in gbnf
+    parser = lark.Lark(grammar.to_lark(), start="start", parser="earley", lexer="dynamic")
+    parser.parse(" F(a) & b")
+    with pytest.raises(lark.exceptions.LarkError):
+        parser.parse("F(a) & b")
+    assert grammar.min_lengths()[grammar.root] == 2

@@ -1,0 +1,63 @@
+"""What every translation backend provides: a completion of one prompt.
+
+A backend turns ``(prompt, grammar or None, max_tokens)`` into a :class:`Completion`.
+With a grammar, the backend guarantees that the returned text is a complete string of
+that grammar, or says it could not (``stop == "length"``); :mod:`ara.eval.translator`
+turns completions into parsed formulas.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+from ara.errors import AraError
+from ara.grammars import BuiltGrammar
+
+
+class BackendError(AraError, RuntimeError):
+    """A backend that cannot run: missing model file, unreachable endpoint, ..."""
+
+
+@dataclass(frozen=True)
+class Completion:
+    """One generated answer.
+
+    Attributes:
+        text: The generated text, without the stop string.
+        prompt_tokens: Tokens in the prompt.
+        completion_tokens: Tokens generated.
+        cached_tokens: Prompt tokens whose KV cache was reused from the previous call.
+        ms: Wall time of the call in milliseconds.
+        stop: ``eos`` (model or grammar ended it), ``stop`` (stop string), ``length``
+            (token budget spent).
+        masked_steps: Steps at which the model's first choice broke the grammar and the
+            mask was computed (constrained decoding only).
+    """
+
+    text: str
+    prompt_tokens: int
+    completion_tokens: int
+    cached_tokens: int
+    ms: float
+    stop: str
+    masked_steps: int = 0
+
+
+class Backend(Protocol):
+    """A model that completes prompts, optionally under a grammar."""
+
+    #: Identifies the model in outputs (file hash, hub id or endpoint and model name).
+    model_id: str
+
+    def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
+                 stop: str) -> Completion:
+        """Greedy completion of ``prompt``.
+
+        Args:
+            prompt: The full prompt.
+            grammar: Constrain the answer to this grammar's language, or ``None``.
+            max_tokens: Token budget for the answer.
+            stop: Unconstrained generation ends at this string (not returned).
+        """
+        ...

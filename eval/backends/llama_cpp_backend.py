@@ -1,0 +1,159 @@
+"""llama.cpp through llama-cpp-python: any GGUF, the embedded Gemma 3 270M by default.
+
+Decoding is our own greedy loop over ``Llama.eval`` rather than ``create_completion``,
+for two reasons. Constraint: llguidance's mask replaces llama.cpp's built-in grammar
+sampler, which checks the whole 262k-token vocabulary at every step (about 2.5x slower
+per formula, measured by ``bench/constrained_overhead.py``). The built-in sampler stays
+available (``mask="llama"``) for faithfulness to the paper's setup. Prefix reuse: the
+longest common token prefix with the previous prompt keeps its KV cache, so a run that
+shares its few-shot examples evaluates them once. The cache is full-size
+(``swa_full``), because Gemma 3's sliding-window cache cannot roll back to an earlier
+position once it has slid past it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import time
+import warnings
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ara.eval.backends.base import BackendError, Completion
+from ara.eval.backends.masking import GrammarMatcher
+from ara.grammars import BuiltGrammar
+from ara.grammars.llama_check import muted_llama_log
+
+MASK_ENGINES = ("llguidance", "llama")
+
+
+@lru_cache(maxsize=8)
+def file_sha256(path: str) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 22), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+class LlamaCppBackend:
+    """A GGUF model run by llama.cpp on the CPU (or GPU layers if built for it).
+
+    Args:
+        model_path: Path to a ``.gguf`` file.
+        n_ctx: Context length in tokens; 20-shot prompts need about 1,500.
+        n_threads: CPU threads; default all cores.
+        mask: ``llguidance`` (fast masks, default) or ``llama`` (llama.cpp's own
+            grammar sampler on the GBNF text).
+        lora_path: Optional GGUF LoRA adapter applied on top of the model.
+
+    Raises:
+        BackendError: If the model file is missing or llama.cpp cannot load it.
+    """
+
+    def __init__(self, model_path: str, n_ctx: int = 4096, n_threads: int | None = None,
+                 mask: str = "llguidance", lora_path: str | None = None) -> None:
+        import llama_cpp
+
+        if mask not in MASK_ENGINES:
+            raise BackendError(f"unknown mask engine {mask!r}; choose one of {MASK_ENGINES}")
+        for path in filter(None, (model_path, lora_path)):
+            if not Path(path).is_file():
+                raise BackendError(f"model file not found: {path}")
+        self._lc = llama_cpp
+        try:
+            with muted_llama_log():
+                self.llm = llama_cpp.Llama(
+                    model_path=str(model_path), n_ctx=n_ctx,
+                    n_threads=n_threads or os.cpu_count(), swa_full=True, verbose=False,
+                    lora_path=lora_path,
+                )
+        except ValueError as err:
+            raise BackendError(f"llama.cpp could not load {model_path}: {err}") from err
+        self.mask = mask
+        self.model_id = f"gguf:{Path(model_path).name}:sha256:{file_sha256(str(model_path))[:16]}"
+        if lora_path:
+            self.model_id += f"+lora:sha256:{file_sha256(str(lora_path))[:16]}"
+        self._vocab = llama_cpp.llama_model_get_vocab(self.llm._model.model)
+        self._eos = {self.llm.token_eos(), *self._end_of_turn()}
+        self._lltokenizer = None
+
+    def _end_of_turn(self) -> list[int]:
+        ids = self.llm.tokenize(b"<end_of_turn>", add_bos=False, special=True)
+        return ids if len(ids) == 1 else []
+
+    @property
+    def lltokenizer(self):
+        """llguidance's view of the vocabulary (built once, ~1 s for 262k tokens)."""
+        if self._lltokenizer is None:
+            from llguidance.llamacpp import lltokenizer_from_vocab
+
+            # llguidance reads each token's attributes through a function llama-cpp-python
+            # has deprecated: 262k identical warnings, nothing for us to act on.
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", "llama_token_get_attr", DeprecationWarning)
+                self._lltokenizer = lltokenizer_from_vocab(self._vocab,
+                                                           eos_token=sorted(self._eos))
+        return self._lltokenizer
+
+    def _logits(self) -> np.ndarray:
+        return np.ctypeslib.as_array(self.llm._ctx.get_logits(), shape=(self.llm.n_vocab(),))
+
+    def _feed_prompt(self, tokens: list[int]) -> int:
+        """Evaluate the prompt, reusing the cached prefix; returns the reused length."""
+        cached = self.llm.input_ids[: self.llm.n_tokens]
+        limit = min(len(cached), len(tokens) - 1)  # evaluate >= 1 token to get logits
+        same = np.flatnonzero(cached[:limit] != np.asarray(tokens[:limit]))
+        reused = int(same[0]) if same.size else limit
+        self.llm.n_tokens = reused
+        self.llm.eval(tokens[reused:])
+        return reused
+
+    def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
+                 stop: str) -> Completion:
+        if grammar is not None and self.mask == "llguidance":
+            self.lltokenizer  # noqa: B018 - built once, outside the timed call
+        start = time.perf_counter()
+        tokens = self.llm.tokenize(prompt.encode(), add_bos=True, special=False)
+        if len(tokens) + max_tokens > self.llm.n_ctx():
+            raise BackendError(
+                f"prompt of {len(tokens)} tokens + {max_tokens} to generate exceeds the "
+                f"context of {self.llm.n_ctx()}; pass a larger n_ctx or fewer shots"
+            )
+        reused = self._feed_prompt(tokens)
+        if grammar is not None and self.mask == "llama":
+            return self._complete_llama_grammar(grammar, max_tokens, len(tokens), reused, start)
+        matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
+        out: list[int] = []
+        text, reason = b"", "length"
+        for _ in range(max_tokens):
+            logits = self._logits()
+            token = matcher.choose(logits) if matcher else int(np.argmax(logits))
+            if token in self._eos:
+                reason = "eos"
+                break
+            out.append(token)
+            text = self.llm.detokenize(out)
+            if matcher is None and stop.encode() in text:
+                text, reason = text[: text.index(stop.encode())], "stop"
+                break
+            self.llm.eval([token])
+        return Completion(text.decode("utf-8", errors="replace"), len(tokens), len(out), reused,
+                          (time.perf_counter() - start) * 1e3, reason,
+                          matcher.masked_steps if matcher else 0)
+
+    def _complete_llama_grammar(self, grammar: BuiltGrammar, max_tokens: int, n_prompt: int,
+                                reused: int, start: float) -> Completion:
+        """Greedy decoding through llama-cpp-python's own grammar sampling (the paper's
+        path): llama.cpp checks every vocabulary entry against the GBNF at each step."""
+        gbnf = self._lc.LlamaGrammar.from_string(grammar.grammar.to_gbnf(), verbose=False)
+        prompt_tokens = self.llm.input_ids[: self.llm.n_tokens].tolist()
+        result = self.llm.create_completion(prompt_tokens, max_tokens=max_tokens, temperature=0.0,
+                                            grammar=gbnf)
+        choice = result["choices"][0]
+        reason = "eos" if choice["finish_reason"] == "stop" else "length"
+        return Completion(choice["text"], n_prompt, result["usage"]["completion_tokens"], reused,
+                          (time.perf_counter() - start) * 1e3, reason)

@@ -1,0 +1,75 @@
+"""Grammar-constrained token choice with llguidance, shared by the local backends.
+
+Greedy decoding under a grammar needs the best *allowed* token. Computing the full
+allowed-token mask costs ~70 µs on Gemma's 262k vocabulary, and applying it to the
+logits costs more than that in numpy; most steps need neither. Sample-then-check:
+take the unconstrained argmax, ask the matcher whether it may follow; only when it
+may not, compute the mask and take the argmax over the allowed tokens. The result is
+exactly the masked greedy choice either way.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from ara.grammars import BuiltGrammar
+
+
+class GrammarMatcher:
+    """One generation's grammar state.
+
+    Args:
+        tokenizer: An ``llguidance.LLTokenizer`` for the model's vocabulary.
+        grammar: The grammar to follow (its Lark text is compiled by llguidance).
+    """
+
+    def __init__(self, tokenizer, grammar: BuiltGrammar) -> None:
+        self._matcher = _compiled(tokenizer, grammar.grammar.to_lark()).deep_copy()
+        self._n_words = (tokenizer.vocab_size + 31) // 32
+        self._mask = np.zeros(self._n_words, dtype=np.int32)
+        self.masked_steps = 0
+
+    def choose(self, logits: np.ndarray) -> int:
+        """The highest-scoring token the grammar allows next, and consume it."""
+        token = int(np.argmax(logits))
+        if token < self._n_words * 32 and self._matcher.try_consume_tokens([token]) == 1:
+            return token
+        self.masked_steps += 1
+        self._matcher.unsafe_compute_mask_ptr(self._mask.ctypes.data, self._mask.nbytes)
+        allowed = allowed_tokens(self._mask, len(logits))
+        if allowed.size == 0:
+            raise RuntimeError(f"grammar allows no token: {self._matcher.get_error()}")
+        token = int(allowed[np.argmax(logits[allowed])])
+        if not self._matcher.consume_token(token):
+            raise RuntimeError(f"llguidance refused its own mask: {self._matcher.get_error()}")
+        return token
+
+    @property
+    def done(self) -> bool:
+        """Whether the grammar has ended (it accepted an end-of-sequence token)."""
+        return self._matcher.is_stopped()
+
+
+@lru_cache(maxsize=256)
+def _compiled(tokenizer, lark_text: str):
+    """A pristine matcher per grammar; each generation works on a deep copy of it."""
+    import llguidance
+
+    matcher = llguidance.LLMatcher(tokenizer, llguidance.LLMatcher.grammar_from_lark(lark_text))
+    if matcher.is_error():
+        raise ValueError(f"llguidance rejected the grammar: {matcher.get_error()}")
+    return matcher
+
+
+def allowed_tokens(mask: np.ndarray, vocab_size: int) -> np.ndarray:
+    """Token ids whose bit is set in an llguidance bitmask (32 tokens per int32 word).
+
+    Only the non-zero words are unpacked: under a grammar, a few dozen of Gemma's
+    262k tokens are allowed at a time.
+    """
+    words = np.flatnonzero(mask)
+    bits = ((mask[words, None].astype(np.uint32) >> np.arange(32, dtype=np.uint32)) & 1)
+    ids = (words[:, None] * 32 + np.arange(32))[bits.astype(bool)]
+    return ids[ids < vocab_size]

@@ -1,0 +1,108 @@
+"""``ara translate`` and ``ara eval ...``: translate one sentence, run and score ablations."""
+
+from __future__ import annotations
+
+import random
+import signal
+from pathlib import Path
+
+import typer
+
+from ara.cli_support import emit, split_list, user_errors
+
+eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
+                       no_args_is_help=True)
+
+MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned, a .gguf path, hf:FOLDER, or an "
+              "OpenAI-compatible http(s):// endpoint")
+
+
+def translate_cmd(
+    nl: str = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'."),
+    aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions."),
+    model: str = typer.Option("default", "--model", help=MODEL_HELP),
+    no_constraint: bool = typer.Option(False, "--no-constraint",
+                                       help="Decode freely instead of under the grammar."),
+    grammar_in_prompt: bool = typer.Option(False, "--grammar-in-prompt",
+                                           help="Show the grammar in the prompt."),
+    shots: int = typer.Option(5, "--shots", help="Worked examples from the paper split's train."),
+    seed: int = typer.Option(0, "--seed", help="Which worked examples."),
+    intervals: bool = typer.Option(False, "--intervals", help="Allow timed operators."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """Translate one instruction into STL over the given propositions."""
+    from ara.data import load_split, prepare
+    from ara.eval.models import make_backend
+    from ara.eval.prompt import sample_shots
+    from ara.eval.translator import Translator, TranslatorConfig
+
+    with user_errors():
+        try:
+            split = load_split("paper")
+        except ValueError:
+            split = prepare("paper")
+        examples = sample_shots(split.records("train", "grounded"), shots, random.Random(seed))
+        translator = Translator(make_backend(model), TranslatorConfig(intervals=intervals))
+        result = translator.translate(nl, split_list(aps), examples, grammar_in_prompt,
+                                      constrained=not no_constraint)
+    data = {"stl": result.stl, "valid": result.valid, "raw": result.raw,
+            "ms": round(result.ms, 1), "error": result.error, "model": translator.backend.model_id,
+            "constrained": result.constrained, "grammar": result.grammar}
+    emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
+
+
+@eval_app.command("ablation")
+def ablation_cmd(
+    out: Path = typer.Option(..., "--out", help="Run folder: samples.jsonl, results.json, ..."),
+    split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
+    form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
+    variants: str = typer.Option("F,F+P,F+P+C", "--variants",
+                                 help="Comma list of variants: letters F, P, C joined by +."),
+    shots: str = typer.Option("5,20", "--shots", help="Comma list of few-shot counts."),
+    reruns: int = typer.Option(3, "--reruns", help="Reruns, each with new examples."),
+    limit: int = typer.Option(1000, "--limit", help="Test pairs to sample."),
+    seed: int = typer.Option(0, "--seed", help="Seeds the test sample and the examples."),
+    model: str = typer.Option("default", "--model", help=MODEL_HELP),
+    mask: str = typer.Option("llguidance", "--mask",
+                             help="Constraint engine: llguidance (fast) or llama (built-in)."),
+    spot_timeout: float = typer.Option(10.0, "--spot-timeout",
+                                       help="Seconds per Spot check before 'undecided'."),
+    resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
+) -> None:
+    """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
+    from ara.eval.ablation import run_ablation
+    from ara.eval.harness import AblationConfig
+    from ara.eval.models import make_backend
+    from ara.eval.report import tables_markdown
+
+    # SIGTERM ends the run like Ctrl-C: finished samples stay, the report is written.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    with user_errors():
+        config = AblationConfig(
+            split=split, form=form, variants=split_list(variants),
+            shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
+            seed=seed, model=model, spot_timeout_s=spot_timeout,
+        )
+        backend = make_backend(model, mask=mask)
+        try:
+            results = run_ablation(config, backend, out, resume, progress=not no_progress)
+        except KeyboardInterrupt:
+            typer.echo(f"interrupted: finished samples are in {out}; continue with --resume",
+                       err=True)
+            raise typer.Exit(130) from None
+    typer.echo(tables_markdown(results))
+    typer.echo(f"wrote {out}/samples.jsonl, results.json, tables.md, plot.png")
+
+
+@eval_app.command("score")
+def score_cmd(
+    folder: Path = typer.Argument(..., help="A run folder from `ara eval ablation`."),
+    as_json: bool = typer.Option(False, "--json", help="Print results.json instead of tables."),
+) -> None:
+    """Re-score a run from its samples.jsonl (no model needed) and rewrite its report."""
+    from ara.eval.report import tables_markdown, write_report
+
+    with user_errors():
+        results = write_report(folder)
+    emit(results, as_json, tables_markdown)

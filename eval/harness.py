@@ -1,0 +1,210 @@
+"""The F/P/C ablation of the paper's Experiment 1, resumable.
+
+Variants are named by their letters joined with ``+``: F (few-shot examples), P (the
+grammar in the prompt), C (grammar-constrained decoding); ``F+P+C`` uses all three.
+Variants without F run zero-shot, once per rerun. Each rerun redraws the few-shot
+examples (seeded); all variants of a run see the same examples and the same test
+pairs. Every generation is appended to ``samples.jsonl`` as soon as it is judged, so
+an interrupted run loses nothing, and ``--resume`` skips exactly the samples on disk.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import random
+import subprocess
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+from ara import __version__
+from ara.data import PreparedSplit, Record
+from ara.data.store import FORMS, SPLITS
+from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
+from ara.eval.prompt import Shot, sample_shots
+from ara.eval.translator import Translator, TranslatorConfig
+from ara.grammars import GRAMMAR_VERSION, parse
+from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
+
+LETTERS = {"F": "few_shot", "P": "grammar_in_prompt", "C": "constrained"}
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One ablation variant, e.g. ``F+P+C``."""
+
+    name: str
+    few_shot: bool
+    grammar_in_prompt: bool
+    constrained: bool
+
+    @classmethod
+    def parse(cls, name: str) -> Variant:
+        letters = name.strip().upper().split("+")
+        unknown = [x for x in letters if x not in LETTERS]
+        if unknown or len(set(letters)) != len(letters) or not name.strip():
+            raise ConfigError(
+                f"variant {name!r}: use the letters F (few-shot), P (grammar in prompt), C "
+                "(constrained decoding) joined with '+', each once, e.g. F+P+C"
+            )
+        canonical = "+".join(x for x in "FPC" if x in letters)
+        return cls(canonical, **{LETTERS[x]: x in letters for x in LETTERS})
+
+
+@dataclass(frozen=True)
+class AblationConfig:
+    """One ablation run.
+
+    Args:
+        split: Prepared split (``paper``, ``disjoint``, ``timed``).
+        form: ``lifted`` or ``grounded`` records.
+        variants: Variant names, e.g. ``("F", "F+P", "F+P+C")``.
+        shots: Few-shot counts for the F variants.
+        reruns: Reruns, each with freshly drawn examples.
+        limit: Test pairs, sampled once with ``seed``.
+        seed: Seeds the test sample and every rerun's examples.
+        data_seed: Seed the split was prepared with.
+        model: What ``--model`` named (recorded; the backend reports its hash).
+        spot_timeout_s: Time limit per Spot check; past it the pair counts as undecided.
+        translator: Grammar and budget settings.
+    """
+
+    split: str = "paper"
+    form: str = "lifted"
+    variants: tuple[str, ...] = ("F", "F+P", "F+P+C")
+    shots: tuple[int, ...] = (5, 20)
+    reruns: int = 3
+    limit: int = 1000
+    seed: int = 0
+    data_seed: int = 0
+    model: str = "default"
+    spot_timeout_s: float = 10.0
+    translator: TranslatorConfig = field(default_factory=TranslatorConfig)
+
+    def __post_init__(self) -> None:
+        if self.split not in SPLITS:
+            raise ConfigError(f"unknown split {self.split!r}. {did_you_mean(self.split, SPLITS)}")
+        if self.form not in FORMS:
+            raise ConfigError(f"unknown form {self.form!r}. {did_you_mean(self.form, FORMS)}")
+        object.__setattr__(self, "variants", tuple(Variant.parse(v).name for v in self.variants))
+        if not self.variants or any(k < 1 for k in self.shots) or self.reruns < 1 or self.limit < 1:
+            raise ConfigError(
+                "need at least one variant, shots >= 1, reruns >= 1 and limit >= 1; got "
+                f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
+                f"limit={self.limit}"
+            )
+
+    def to_dict(self) -> dict:
+        data = asdict(self)
+        data["variants"], data["shots"] = list(self.variants), list(self.shots)
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict) -> AblationConfig:
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise ConfigError(f"unknown keys {sorted(unknown)}; known: {sorted(known)}")
+        data = dict(data)
+        data["variants"], data["shots"] = tuple(data["variants"]), tuple(data["shots"])
+        data["translator"] = TranslatorConfig(**data.get("translator", {}))
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One generation to do."""
+
+    rerun: int
+    shots: int
+    variant: Variant
+    record: Record
+    examples: tuple[Shot, ...]
+
+    @property
+    def key(self) -> tuple[str, int, int, str]:
+        return (self.variant.name, self.shots, self.rerun, self.record.uid)
+
+
+def test_sample(config: AblationConfig, split: PreparedSplit) -> list[Record]:
+    """The test pairs of the run: ``limit`` records drawn with ``seed``."""
+    records = split.records("test", config.form)
+    if not records:
+        raise ConfigError(f"split {config.split} has no {config.form} test records")
+    if config.limit >= len(records):
+        return records
+    return random.Random(config.seed).sample(records, config.limit)
+
+
+def plan(config: AblationConfig, split: PreparedSplit) -> Iterator[Job]:
+    """Every generation of the run, grouped so that consecutive prompts share a prefix."""
+    tests = test_sample(config, split)
+    pool = split.records("train", config.form)
+    variants = [Variant.parse(v) for v in config.variants]
+    for rerun in range(config.reruns):
+        groups = [(k, [v for v in variants if v.few_shot]) for k in config.shots]
+        groups.append((0, [v for v in variants if not v.few_shot]))
+        for shots, group in groups:
+            rng = random.Random(f"{config.seed}:{rerun}:{shots}")
+            examples = tuple(sample_shots(pool, shots, rng)) if shots else ()
+            for variant in group:
+                for record in tests:
+                    yield Job(rerun, shots, variant, record, examples)
+
+
+def judge(reference: str, output: str | None, timeout_s: float) -> dict:
+    """Spot's verdicts on one output: equivalent to, and implying, the reference."""
+    if output is None:
+        return {"equivalent": None, "implies": None, "spot": "invalid"}
+    ref, out = parse(reference), parse(output)
+    try:
+        eq = equivalent(out, ref, timeout_s=timeout_s)
+        imp = True if eq else implies(out, ref, timeout_s=timeout_s)
+        return {"equivalent": eq, "implies": imp, "spot": "ok"}
+    except SpotTimeoutError:
+        return {"equivalent": None, "implies": None, "spot": "timeout"}
+    except BoundTooLargeError:
+        return {"equivalent": None, "implies": None, "spot": "bound"}
+
+
+def run_job(translator: Translator, job: Job, timeout_s: float) -> dict:
+    """Translate one test pair and judge it: one line of samples.jsonl."""
+    r = job.record
+    result = translator.translate(r.nl, r.aps, job.examples, job.variant.grammar_in_prompt,
+                                  job.variant.constrained)
+    return {
+        "variant": job.variant.name, "shots": job.shots, "rerun": job.rerun, "uid": r.uid,
+        "nl": r.nl, "aps": list(r.aps), "reference": r.stl, "raw": result.raw,
+        "stl": result.stl, "valid": result.valid, "error": result.error,
+        **judge(r.stl, result.stl, timeout_s),
+        "ms": round(result.ms, 2), "prompt_tokens": result.prompt_tokens,
+        "completion_tokens": result.completion_tokens, "cached_tokens": result.cached_tokens,
+        "stop": result.stop, "masked_steps": result.masked_steps,
+        "prompt_sha256": result.prompt_sha256,
+    }
+
+
+def run_metadata(config: AblationConfig, split: PreparedSplit, model_id: str) -> dict:
+    """What produced the run: config, model, data, grammar, code and machine."""
+    return {
+        "config": config.to_dict(),
+        "model_id": model_id,
+        "data": {"split": config.split, "version": split.version,
+                 "manifest_version": split.manifest["version"]},
+        "grammar_version": GRAMMAR_VERSION,
+        "seed": config.seed,
+        "ara_version": __version__,
+        "git_commit": _git_commit(),
+        "machine": {"platform": platform.platform(), "processor": platform.machine(),
+                    "cpus": os.cpu_count()},
+    }
+
+
+def _git_commit() -> str | None:
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                             cwd=Path(__file__).parent, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return out.stdout.strip() or None

@@ -1,0 +1,112 @@
+"""The paper's metrics over sample records, as pure functions.
+
+Within one run (a rerun at one shot count), every variant translated the same test
+pairs. Then:
+
+* validity of a variant: the share of its outputs that parse;
+* accuracy: the share logically equivalent to the reference, over the pairs that are
+  valid under *all* variants of that run, so variants are compared on the same set;
+* containment: of the outputs in that set that are valid but wrong, the share that
+  imply the reference (the model asked for something stronger, never weaker).
+
+Each is then averaged over reruns (mean and sample standard deviation). Pairs whose
+Spot check ran out of time are left out of accuracy and containment and counted.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import defaultdict
+from collections.abc import Iterable
+from typing import TypedDict
+
+
+class Stat(TypedDict):
+    """A metric over reruns, in percent (latency: milliseconds)."""
+
+    mean: float
+    std: float
+    n: int
+
+
+class VariantResult(TypedDict):
+    """One variant at one shot count."""
+
+    variant: str
+    shots: int
+    validity: Stat
+    accuracy: Stat
+    containment: Stat
+    latency_ms: Stat
+    common_pairs: Stat
+    undecided: int
+
+
+def _stat(values: list[float]) -> Stat:
+    if not values:
+        return Stat(mean=float("nan"), std=float("nan"), n=0)
+    std = statistics.stdev(values) if len(values) > 1 else 0.0
+    return Stat(mean=round(statistics.fmean(values), 4), std=round(std, 4), n=len(values))
+
+
+def _pct(k: int, n: int) -> float | None:
+    return 100.0 * k / n if n else None
+
+
+def score(samples: Iterable[dict]) -> list[VariantResult]:
+    """Metrics per (variant, shots) from sample records.
+
+    Each sample needs ``variant``, ``shots``, ``rerun``, ``uid``, ``valid``,
+    ``equivalent`` (bool, or ``None`` when undecided), ``implies`` and ``ms``.
+    """
+    runs: dict[tuple[int, int], dict[str, dict[str, dict]]] = defaultdict(
+        lambda: defaultdict(dict))
+    for s in samples:
+        runs[(s["shots"], s["rerun"])][s["variant"]][s["uid"]] = s
+    per: dict[tuple[str, int], dict[str, list]] = defaultdict(lambda: defaultdict(list))
+    undecided: dict[tuple[str, int], int] = defaultdict(int)
+    for (shots, _rerun), by_variant in sorted(runs.items()):
+        uid_sets = [set(v) for v in by_variant.values()]
+        shared = set.intersection(*uid_sets)  # pairs every variant has translated
+        common = {u for u in shared if all(by_variant[v][u]["valid"] for v in by_variant)}
+        for variant, by_uid in by_variant.items():
+            key = (variant, shots)
+            rows = [by_uid[u] for u in sorted(shared)]
+            decided = [by_uid[u] for u in sorted(common) if by_uid[u]["equivalent"] is not None]
+            undecided[key] += len(common) - len(decided)
+            wrong = [s for s in decided if not s["equivalent"]]
+            for name, value in (
+                ("validity", _pct(sum(s["valid"] for s in rows), len(rows))),
+                ("accuracy", _pct(sum(s["equivalent"] for s in decided), len(decided))),
+                ("containment", _pct(sum(bool(s["implies"]) for s in wrong), len(wrong))),
+                ("latency_ms", statistics.fmean(s["ms"] for s in rows) if rows else None),
+                ("common_pairs", float(len(common))),
+            ):
+                if value is not None:
+                    per[key][name].append(value)
+    return [
+        VariantResult(variant=v, shots=k, undecided=undecided[(v, k)],
+                      **{m: _stat(per[(v, k)][m]) for m in
+                         ("validity", "accuracy", "containment", "latency_ms", "common_pairs")})
+        for (v, k) in sorted(per, key=lambda key: (key[1], _variant_order(key[0])))
+    ]
+
+
+def _variant_order(name: str) -> tuple[int, str]:
+    return (len(name), name)
+
+
+def overhead(results: list[VariantResult]) -> dict[str, float]:
+    """Constrained-vs-unconstrained latency ratio at each shot count: X+C over X.
+
+    Returns:
+        ``{"F+P+C / F+P @ 5 shots": 1.03, ...}`` for every pair present.
+    """
+    by_key = {(r["variant"], r["shots"]): r["latency_ms"]["mean"] for r in results}
+    ratios = {}
+    for (variant, shots), ms in sorted(by_key.items()):
+        if variant.endswith("+C") or variant == "C":
+            base = variant[:-2] if variant.endswith("+C") else None
+            if base and (base, shots) in by_key and by_key[(base, shots)]:
+                ratios[f"{variant} / {base} @ {shots} shots"] = round(ms / by_key[(base, shots)], 3)
+    return ratios

@@ -1,0 +1,60 @@
+"""What ``--model`` can name, and the backend each becomes.
+
+* ``default``: the embedded Gemma 3 270M Q4_K_M GGUF, through llama.cpp;
+* ``finetuned``: the fine-tuned adapter shipped in ``eval/models/`` on the embedded base;
+* a path ending in ``.gguf``: that file, through llama.cpp (exported fine-tunes, Gemma 3
+  12B on a bigger machine);
+* ``hf:DIR_OR_ID``: a Hugging Face model through transformers (local folder, or a hub id
+  already in the local cache: nothing is downloaded);
+* ``http://...`` or ``https://...``: an OpenAI-compatible endpoint (unconstrained only).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ara.eval.backends.base import Backend, BackendError
+
+SHIPPED = Path(__file__).parent / "models"
+FINETUNED_LORA = SHIPPED / "gemma3-270m-nl2tl-lora.gguf"
+
+
+def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
+                 api_model: str | None = None) -> Backend:
+    """The backend for a ``--model`` value (see the module doc).
+
+    Raises:
+        BackendError: If the model cannot be found, with what to do instead.
+    """
+    if model == "default":
+        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+        from ara.grammars.llama_check import default_model_path
+
+        return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
+    if model == "finetuned":
+        if not FINETUNED_LORA.is_file():
+            raise BackendError(
+                f"no fine-tuned adapter at {FINETUNED_LORA}: this release ships none yet. "
+                "Use --model default, or a GGUF path from `ara export`"
+            )
+        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+        from ara.grammars.llama_check import default_model_path
+
+        return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask,
+                               lora_path=str(FINETUNED_LORA))
+    if model.startswith(("http://", "https://")):
+        from ara.eval.backends.openai_http import OpenAIBackend
+
+        return OpenAIBackend(model, api_model or "default")
+    if model.startswith("hf:"):
+        from ara.eval.backends.hf_backend import HFBackend
+
+        return HFBackend(model[3:], mask=mask)
+    if model.endswith(".gguf"):
+        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+
+        return LlamaCppBackend(model, n_ctx=n_ctx, mask=mask)
+    raise BackendError(
+        f"--model {model!r} names no model: use default, finetuned, a path ending in .gguf, "
+        "hf:FOLDER_OR_ID, or an http(s):// endpoint"
+    )

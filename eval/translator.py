@@ -1,0 +1,164 @@
+"""NL -> STL: prompt a backend, optionally under the request's grammar, parse the answer.
+
+Validity under the constraint is a guarantee, not a statistic. The decoding grammar
+is the canonical layout bounded in depth and width, so its language is finite and no
+string is longer than ``max_length()`` characters. The token budget is that length
+(every grammar token spends at least one character), so generation always ends in a
+complete formula, and :meth:`Syntax.check` is then asserted on it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+from ara.errors import ConfigError, STLSyntaxError
+from ara.eval.backends.base import Backend
+from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
+from ara.grammars import BuiltGrammar, Syntax, build_grammar, parse, to_text
+
+#: The space a model writes after "STL:"; part of the decoding grammar, stripped after.
+ANSWER_PREFIX = " "
+
+
+@dataclass(frozen=True)
+class TranslatorConfig:
+    """How requests become grammars and prompts.
+
+    Args:
+        max_depth: Nesting depth the constrained grammar allows (NL2TL needs <= 4).
+        max_args: Arguments of one & or | the constrained grammar allows. NL2TL needs 2,
+            and 2 loses nothing (``(a & b) & c`` nests) while keeping the longest
+            string, hence the worst-case token budget, short.
+        intervals: Whether formulas may carry time intervals.
+        max_bound: Largest interval bound, with ``intervals``.
+        max_tokens: Budget for unconstrained answers.
+    """
+
+    max_depth: int = 5
+    max_args: int = 2
+    intervals: bool = False
+    max_bound: int = 1000
+    max_tokens: int = 96
+
+    def __post_init__(self) -> None:
+        if self.max_depth < 1 or self.max_args < 2 or self.max_tokens < 1:
+            raise ConfigError(
+                f"need max_depth >= 1, max_args >= 2, max_tokens >= 1; got {self.max_depth}, "
+                f"{self.max_args}, {self.max_tokens}"
+            )
+
+    def syntax(self, aps: Sequence[str]) -> Syntax:
+        return Syntax(aps=tuple(aps), intervals=self.intervals, max_bound=self.max_bound,
+                      max_depth=self.max_depth, max_args=self.max_args)
+
+
+@dataclass(frozen=True)
+class TranslationResult:
+    """One translation.
+
+    Attributes:
+        nl: The instruction.
+        aps: Its atomic propositions.
+        raw: The model's text.
+        stl: Canonical formula, or ``None`` if the text does not parse.
+        valid: Whether ``raw`` parses as STL.
+        error: The parse error, if any.
+        constrained: Whether decoding was grammar-constrained.
+        grammar_in_prompt: Whether the prompt showed the grammar.
+        shots: Number of worked examples in the prompt.
+        prompt_sha256: Short hash of the exact prompt.
+        prompt_tokens, completion_tokens, cached_tokens: Token counts.
+        ms: Wall time of the backend call.
+        stop: Why generation ended (``eos``, ``stop``, ``length``).
+        masked_steps: Steps where the grammar overruled the model's first choice.
+        grammar: Provenance of the decoding grammar (version, hash), if constrained.
+    """
+
+    nl: str
+    aps: tuple[str, ...]
+    raw: str
+    stl: str | None
+    valid: bool
+    error: str | None
+    constrained: bool
+    grammar_in_prompt: bool
+    shots: int
+    prompt_sha256: str
+    prompt_tokens: int
+    completion_tokens: int
+    cached_tokens: int
+    ms: float
+    stop: str
+    masked_steps: int
+    grammar: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        data = asdict(self)
+        data["aps"] = list(self.aps)
+        return data
+
+
+class Translator:
+    """Translate instructions with one backend.
+
+    Args:
+        backend: Any :class:`~ara.eval.backends.base.Backend`.
+        config: Grammar and budget settings.
+    """
+
+    def __init__(self, backend: Backend, config: TranslatorConfig | None = None) -> None:
+        self.backend = backend
+        self.config = config or TranslatorConfig()
+
+    def grammar(self, aps: Sequence[str]) -> BuiltGrammar:
+        return build_grammar(self.config.syntax(aps))
+
+    def translate(self, nl: str, aps: Sequence[str], shots: Sequence[Shot] = (),
+                  grammar_in_prompt: bool = False, constrained: bool = True) -> TranslationResult:
+        """Translate ``nl`` over the propositions ``aps``.
+
+        Args:
+            nl: The instruction.
+            aps: Its atomic propositions (the grammar admits exactly these).
+            shots: Worked examples for the prompt (variant F).
+            grammar_in_prompt: Show the grammar in the prompt (variant P).
+            constrained: Decode under the grammar (variant C).
+        """
+        aps = tuple(aps)
+        built = self.grammar(aps)
+        shown = grammar_for_prompt(built.syntax) if grammar_in_prompt else None
+        prompt = build_prompt(nl, aps, shots, shown)
+        if constrained:
+            decoding = BuiltGrammar(built.syntax, built.grammar.with_prefix(ANSWER_PREFIX))
+            budget = int(decoding.grammar.max_length()) + 1
+            completion = self.backend.complete(prompt, decoding, budget, STOP)
+        else:
+            completion = self.backend.complete(prompt, None, self.config.max_tokens, STOP)
+        raw = completion.text
+        stl, error = None, None
+        try:
+            stl = to_text(parse(raw))
+        except STLSyntaxError as err:
+            error = str(err).splitlines()[0]
+        if constrained:
+            self._check_guarantee(built, raw, completion.stop)
+        return TranslationResult(
+            nl=nl, aps=aps, raw=raw, stl=stl, valid=stl is not None, error=error,
+            constrained=constrained, grammar_in_prompt=grammar_in_prompt, shots=len(shots),
+            prompt_sha256=prompt_sha256(prompt), prompt_tokens=completion.prompt_tokens,
+            completion_tokens=completion.completion_tokens,
+            cached_tokens=completion.cached_tokens, ms=completion.ms, stop=completion.stop,
+            masked_steps=completion.masked_steps,
+            grammar=built.provenance() if constrained else {},
+        )
+
+    @staticmethod
+    def _check_guarantee(built: BuiltGrammar, raw: str, stop: str) -> None:
+        """A constrained answer is ' ' + a string of the language; anything else is a bug."""
+        if not raw.startswith(ANSWER_PREFIX) or not built.syntax.accepts(raw[1:]):
+            raise AssertionError(
+                f"constrained decoding produced {raw!r} (stop={stop}), which the grammar does "
+                "not admit; this is a bug in the backend's constraint, please report it"
+            )
+

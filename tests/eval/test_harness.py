@@ -1,0 +1,57 @@
+"""Variants, run configs and the run plan."""
+
+import pytest
+
+from ara.data import load_split, prepare
+from ara.errors import ConfigError
+from ara.eval.harness import AblationConfig, Variant, plan
+
+
+@pytest.mark.parametrize(
+    ("name", "flags"),
+    [
+        ("F", (True, False, False)),
+        ("f+p", (True, True, False)),  # case does not matter
+        ("C+P+F", (True, True, True)),  # order does not matter; printed as F+P+C
+        ("C", (False, False, True)),  # constrained zero-shot
+    ],
+)
+def test_variant_names_set_their_letters(name, flags):
+    """Tests parsing variant names into their three switches."""
+    v = Variant.parse(name)
+    assert (v.few_shot, v.grammar_in_prompt, v.constrained) == flags
+    assert v.name == "+".join(x for x in "FPC" if x in name.upper())
+
+
+@pytest.mark.parametrize("name", ["F+X", "F+F", "", "FP"])
+def test_bad_variant_names_say_what_is_allowed(name):
+    """Tests the message for unknown letters, repeats and missing separators."""
+    with pytest.raises(ConfigError, match=r"letters F \(few-shot\), P"):
+        Variant.parse(name)
+
+
+def test_config_round_trips_and_refuses_unknown_keys():
+    """Tests AblationConfig through to_dict/from_dict, and a misspelt key."""
+    config = AblationConfig(variants=("F", "f+p+c"), shots=(5,), reruns=2, limit=10)
+    assert AblationConfig.from_dict(config.to_dict()) == config
+    with pytest.raises(ConfigError, match="unknown keys \\['rerun'\\]"):
+        AblationConfig.from_dict({**config.to_dict(), "rerun": 1})
+    with pytest.raises(ConfigError, match="Did you mean 'disjoint'"):
+        AblationConfig(split="disjont")
+
+
+def test_plan_covers_every_variant_shot_and_rerun_once():
+    """Tests the plan's size, uniqueness, and shared examples within a run."""
+    try:
+        split = load_split("paper")
+    except ValueError:
+        split = prepare("paper")
+    config = AblationConfig(variants=("F", "F+P+C", "C"), shots=(2, 3), reruns=2, limit=4)
+    jobs = list(plan(config, split))
+    assert len(jobs) == 2 * (2 * 2 + 1) * 4  # reruns x (F variants x shots + zero-shot C) x pairs
+    assert len({j.key for j in jobs}) == len(jobs)
+    run = [j for j in jobs if j.rerun == 0 and j.shots == 3]
+    assert len({j.examples for j in run}) == 1 and len(run[0].examples) == 3
+    assert {j.examples for j in jobs if j.variant.name == "C"} == {()}
+    rerun_examples = {j.rerun: j.examples for j in jobs if j.shots == 2}
+    assert rerun_examples[0] != rerun_examples[1]  # examples are redrawn per rerun
