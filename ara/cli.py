@@ -9,6 +9,7 @@ from ara.data.cli import data_app
 from ara.demo import demo_cmd
 from ara.eval.cli import eval_app, translate_cmd
 from ara.grammars.cli import grammar_cmd, stl_app
+from ara.training.cli import model_app
 
 app = typer.Typer(
     help="ask-reason-assist: natural language to Signal Temporal Logic with guaranteed "
@@ -19,6 +20,7 @@ app = typer.Typer(
 app.add_typer(stl_app, name="stl")
 app.add_typer(data_app, name="data")
 app.add_typer(eval_app, name="eval")
+app.add_typer(model_app, name="model")
 app.command("translate")(translate_cmd)
 app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)

@@ -13,7 +13,14 @@ VENV=${ARA_VENV:-.venv}
 PYTHON=${PYTHON:-python3}
 stamp="$VENV/.ara-setup-$(cat pyproject.toml scripts/setup.sh | sha256sum | cut -c1-16)"
 
+prepare_model() {
+    # The embedded GGUF as a HF folder for the transformers backend and fine-tuning;
+    # converted once into ~/.cache/ara (about 2 min), then found in a second.
+    "$VENV/bin/ara" model prepare >/dev/null
+}
+
 if [ -f "$stamp" ]; then
+    prepare_model
     echo "setup: $VENV is up to date ($(basename "$stamp"))"
     exit 0
 fi
@@ -33,4 +40,6 @@ pip install -qq -e ".[all]"
 
 rm -f "$VENV"/.ara-setup-*
 touch "$stamp"
+echo "setup: converting the embedded model to a HF folder (once, ~2 min)"
+prepare_model
 echo "setup: done ($VENV)"

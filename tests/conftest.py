@@ -94,3 +94,22 @@ def paper_split():
         return load_split("paper")
     except ValueError:
         return prepare("paper")
+
+
+@pytest.fixture(scope="session")
+def hf_model_dir():
+    """The embedded model as a HF folder (`make setup` converts it once)."""
+    from ara.training.hf_model import default_hf_dir, is_prepared
+
+    folder = default_hf_dir()
+    if not is_prepared(folder):
+        pytest.skip(f"no converted model in {folder}: run `ara model prepare` (make setup does)")
+    return str(folder)
+
+
+@pytest.fixture(scope="session")
+def hf_backend(hf_model_dir):
+    """The embedded model through transformers with llguidance masks (loaded once)."""
+    from ara.eval.backends.hf_backend import HFBackend
+
+    return HFBackend(hf_model_dir)

@@ -1,0 +1,140 @@
+"""A Hugging Face transformers model, constrained through llguidance or outlines.
+
+``mask="llguidance"`` (default) runs our own greedy loop: the KV cache of the longest
+common prefix with the previous prompt is kept (``DynamicCache.crop``), and the
+grammar is applied with sample-then-check exactly as in the llama.cpp backend.
+``mask="outlines"`` hands each call to ``outlines.Generator`` with a ``CFG`` output type,
+which is the library path the paper's setup describes. It is kept for faithfulness;
+``bench/constrained_overhead.py`` measures its cost.
+
+Models load with ``local_files_only=True``: a local folder (``ara model prepare`` makes
+one from the embedded GGUF) or a hub id already in the local cache. Nothing downloads.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ara.eval.backends.base import BackendError, Completion
+from ara.eval.backends.masking import GrammarMatcher
+from ara.grammars import BuiltGrammar
+
+MASK_ENGINES = ("llguidance", "outlines")
+
+
+class HFBackend:
+    """Greedy completions from a transformers causal LM.
+
+    Args:
+        model: Local folder or cached hub id.
+        mask: ``llguidance`` or ``outlines``.
+        device: ``cpu``, ``cuda``, ... (default: cuda if available).
+        dtype: torch dtype name for the weights (default float32 on CPU, bfloat16 on GPU).
+    """
+
+    def __init__(self, model: str, mask: str = "llguidance", device: str | None = None,
+                 dtype: str | None = None) -> None:
+        import torch
+        from transformers import AutoModelForCausalLM, AutoTokenizer
+
+        if mask not in MASK_ENGINES:
+            raise BackendError(f"unknown mask engine {mask!r}; choose one of {MASK_ENGINES}")
+        self.device = device or ("cuda" if torch.cuda.is_available() else "cpu")
+        dtype = dtype or ("float32" if self.device == "cpu" else "bfloat16")
+        try:
+            self.tokenizer = AutoTokenizer.from_pretrained(model, local_files_only=True)
+            self.model = AutoModelForCausalLM.from_pretrained(
+                model, local_files_only=True, dtype=getattr(torch, dtype)).to(self.device)
+        except OSError as err:
+            raise BackendError(
+                f"cannot load {model!r} locally ({err.__class__.__name__}); give a folder "
+                "(`ara model prepare` converts the embedded model) or a hub id already cached"
+            ) from err
+        self.model.eval()
+        self.mask = mask
+        self.model_id = f"hf:{Path(model).name}"
+        self._torch = torch
+        eos = self.model.generation_config.eos_token_id
+        self._eos = set(eos if isinstance(eos, list) else [eos]) | {self.tokenizer.eos_token_id}
+        self._eos.discard(None)
+        self._cache = None
+        self._cached_ids: list[int] = []
+        self._lltokenizer = None
+        self._outlines = None
+
+    @property
+    def lltokenizer(self):
+        if self._lltokenizer is None:
+            import llguidance.hf
+
+            self._lltokenizer = llguidance.hf.from_tokenizer(self.tokenizer,
+                                                             eos_token=sorted(self._eos))
+        return self._lltokenizer
+
+    def _forward(self, ids: list[int]) -> np.ndarray:
+        """Feed ``ids`` after the cached ones; the last position's logits as float32."""
+        torch = self._torch
+        with torch.inference_mode():
+            out = self.model(input_ids=torch.tensor([ids], device=self.device),
+                             past_key_values=self._cache, use_cache=True)
+        self._cache = out.past_key_values
+        self._cached_ids += ids
+        return out.logits[0, -1].float().cpu().numpy()
+
+    def _feed_prompt(self, ids: list[int]) -> tuple[np.ndarray, int]:
+        from transformers import DynamicCache
+
+        limit = min(len(self._cached_ids), len(ids) - 1)
+        reused = next((i for i in range(limit) if self._cached_ids[i] != ids[i]), limit)
+        if reused and self._cache is not None:
+            # crop() takes minus the number of tokens to drop. The cache was made without a
+            # config, so every layer keeps all positions (the sliding-window layers too),
+            # which is what makes rolling back exact.
+            self._cache.crop(reused - len(self._cached_ids))
+            self._cached_ids = self._cached_ids[:reused]
+        else:
+            self._cache, self._cached_ids, reused = DynamicCache(), [], 0
+        return self._forward(ids[reused:]), reused
+
+    def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
+                 stop: str) -> Completion:
+        if grammar is not None and self.mask == "llguidance":
+            self.lltokenizer  # noqa: B018 - built once, outside the timed call
+        if grammar is not None and self.mask == "outlines":
+            return self._complete_outlines(prompt, grammar, max_tokens)
+        start = time.perf_counter()
+        ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
+        logits, reused = self._feed_prompt(ids)
+        matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
+        out: list[int] = []
+        text, reason = "", "length"
+        for _ in range(max_tokens):
+            token = matcher.choose(logits) if matcher else int(np.argmax(logits))
+            if token in self._eos:
+                reason = "eos"
+                break
+            out.append(token)
+            text = self.tokenizer.decode(out)
+            if matcher is None and stop in text:
+                text, reason = text[: text.index(stop)], "stop"
+                break
+            logits = self._forward([token])
+        return Completion(text, len(ids), len(out), reused, (time.perf_counter() - start) * 1e3,
+                          reason, matcher.masked_steps if matcher else 0)
+
+    def _complete_outlines(self, prompt: str, grammar: BuiltGrammar,
+                           max_tokens: int) -> Completion:
+        import outlines
+        from outlines.types import CFG
+
+        if self._outlines is None:
+            self._outlines = outlines.from_transformers(self.model, self.tokenizer)
+        start = time.perf_counter()
+        generator = outlines.Generator(self._outlines, CFG(grammar.grammar.to_lark()))
+        text = generator(prompt, max_new_tokens=max_tokens, do_sample=False)
+        n_prompt = len(self.tokenizer(prompt)["input_ids"])
+        n_out = len(self.tokenizer(text, add_special_tokens=False)["input_ids"])
+        return Completion(text, n_prompt, n_out, 0, (time.perf_counter() - start) * 1e3, "eos")

@@ -1,0 +1,26 @@
+"""``ara model ...``: base models for fine-tuning and the Hugging Face backend."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from ara.cli_support import user_errors
+
+model_app = typer.Typer(help="Prepare base models (no downloads).", no_args_is_help=True)
+
+
+@model_app.command("prepare")
+def prepare_cmd(
+    out: Path = typer.Option(None, "--out",
+                             help="Target folder [default: ~/.cache/ara/models/gemma-3-270m-hf]."),
+    gguf: str = typer.Option(None, "--gguf", help="GGUF to convert [default: embedded 270M]."),
+    force: bool = typer.Option(False, "--force", help="Convert again even if done."),
+) -> None:
+    """Convert the embedded Gemma 3 270M GGUF into a local HF folder, once (~2 min)."""
+    from ara.training.hf_model import prepare_base_model
+
+    with user_errors():
+        folder = prepare_base_model(out, gguf, force)
+    typer.echo(str(folder))

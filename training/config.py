@@ -1,0 +1,160 @@
+"""Typed configuration of a LoRA fine-tuning run, loaded from YAML.
+
+Each YAML section goes straight into its dataclass, so a misspelt key raises with
+the list of known ones instead of being ignored.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+import yaml
+
+from ara.errors import ConfigError, did_you_mean
+
+
+def _build(cls, data: dict | None, where: str):
+    data = data or {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where} must be a mapping, got {type(data).__name__}")
+    known = {f.name for f in fields(cls)}
+    for key in data:
+        if key not in known:
+            raise ConfigError(f"unknown key {where}.{key}. {did_you_mean(key, known)}")
+    return cls(**data)
+
+
+@dataclass(frozen=True)
+class LoraSettings:
+    """The adapter.
+
+    Args:
+        r: Rank, >= 1. Default 16.
+        alpha: Scale numerator (the update is scaled by alpha / r). Default 32.
+        dropout: Dropout on the adapter input, in [0, 1). Default 0.05.
+        target_modules: ``all-linear`` or a list of module names.
+    """
+
+    r: int = 16
+    alpha: int = 32
+    dropout: float = 0.05
+    target_modules: str | list[str] = "all-linear"
+
+    def __post_init__(self) -> None:
+        if self.r < 1 or self.alpha < 1 or not 0 <= self.dropout < 1:
+            raise ConfigError(f"lora needs r >= 1, alpha >= 1, 0 <= dropout < 1; got {self}")
+
+
+@dataclass(frozen=True)
+class OptimSettings:
+    """Optimizer and schedule.
+
+    Args:
+        lr: Peak learning rate (AdamW), > 0. Default 2e-4.
+        batch_size: Sequences per step per device, >= 1. Default 8.
+        grad_accum: Micro-batches per optimizer step, >= 1. Default 1.
+        epochs: Passes over the training records, >= 1. Default 1.
+        warmup_steps: Linear warm-up steps, >= 0. Default 20.
+        weight_decay: AdamW weight decay, >= 0. Default 0.
+    """
+
+    lr: float = 2e-4
+    batch_size: int = 8
+    grad_accum: int = 1
+    epochs: int = 1
+    warmup_steps: int = 20
+    weight_decay: float = 0.0
+
+    def __post_init__(self) -> None:
+        if (self.lr <= 0 or self.batch_size < 1 or self.grad_accum < 1 or self.epochs < 1
+                or self.warmup_steps < 0 or self.weight_decay < 0):
+            raise ConfigError(f"optim values out of range: {self}")
+
+
+@dataclass(frozen=True)
+class DataSettings:
+    """Which records to train on.
+
+    Args:
+        split: Prepared split (``paper``, ``disjoint``, ``timed``).
+        seed: Seed the split was prepared with.
+        forms: ``lifted``, ``grounded`` or both.
+        limit: Use only the first N training records (``None``: all).
+    """
+
+    split: str = "paper"
+    seed: int = 0
+    forms: tuple[str, ...] = ("lifted", "grounded")
+    limit: int | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "forms", tuple(self.forms))
+        bad = [f for f in self.forms if f not in ("lifted", "grounded")]
+        if bad or not self.forms:
+            raise ConfigError(f"data.forms must name lifted and/or grounded, got {self.forms}")
+        if self.limit is not None and self.limit < 1:
+            raise ConfigError(f"data.limit must be >= 1 or null, got {self.limit}")
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One fine-tuning run.
+
+    Args:
+        base_model: ``default`` (the embedded Gemma 3 270M, converted by ``ara model
+            prepare``), a local HF folder, or a hub id already in the local cache.
+        out: Run folder: checkpoints, the adapter, ``train_log.jsonl``, ``run.json``.
+        seed: Seeds the data order, dropout and adapter initialization.
+        max_steps: Stop after this many optimizer steps (``None``: the epochs decide).
+        checkpoint_every: Save a resumable checkpoint every N steps, >= 1.
+        eval_pairs: Test pairs for the held-out check at the end (0: none).
+        lora, optim, data: Sub-configs (see each).
+    """
+
+    base_model: str = "default"
+    out: str = "runs/train/gemma3-270m-lora"
+    seed: int = 0
+    max_steps: int | None = None
+    checkpoint_every: int = 100
+    eval_pairs: int = 100
+    lora: LoraSettings = field(default_factory=LoraSettings)
+    optim: OptimSettings = field(default_factory=OptimSettings)
+    data: DataSettings = field(default_factory=DataSettings)
+
+    def __post_init__(self) -> None:
+        if self.max_steps is not None and self.max_steps < 1:
+            raise ConfigError(f"max_steps must be >= 1 or null, got {self.max_steps}")
+        if self.checkpoint_every < 1 or self.eval_pairs < 0:
+            raise ConfigError("checkpoint_every must be >= 1 and eval_pairs >= 0")
+
+    @classmethod
+    def from_dict(cls, data: dict) -> TrainConfig:
+        data = dict(data)
+        subs = {"lora": LoraSettings, "optim": OptimSettings, "data": DataSettings}
+        parts = {k: _build(c, data.pop(k, None), k) for k, c in subs.items()}
+        return cls(**_checked(cls, data), **parts)
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> TrainConfig:
+        path = Path(path)
+        if not path.is_file():
+            raise ConfigError(f"config file not found: {path}")
+        return cls.from_dict(yaml.safe_load(path.read_text()) or {})
+
+    def to_dict(self) -> dict:
+        data = asdict(self)
+        data["data"]["forms"] = list(self.data.forms)
+        return data
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, indent=2)
+
+
+def _checked(cls, data: dict) -> dict:
+    known = {f.name for f in fields(cls)} - {"lora", "optim", "data"}
+    for key in data:
+        if key not in known:
+            raise ConfigError(f"unknown key {key}. {did_you_mean(key, known)}")
+    return data

@@ -1,0 +1,90 @@
+"""The embedded Gemma 3 270M as a local Hugging Face folder, converted once.
+
+transformers 5 reads the GGUF (dequantized to float32, ``Gemma3ForCausalLM``, 268M
+parameters), but slowly: about a minute for its 262k-token tokenizer alone, and a
+model loaded from GGUF refuses ``save_pretrained``. So the conversion copies its state
+dict into a fresh ``Gemma3ForCausalLM(config)``, saves that with the tokenizer, and
+writes ``ara_model.json`` (source GGUF hash, versions) beside them. Later calls find
+the folder and return at once. Nothing is downloaded.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+from ara import __version__
+from ara.errors import AraError
+
+MANIFEST = "ara_model.json"
+
+
+class ModelPrepError(AraError, RuntimeError):
+    """The base model could not be converted or found."""
+
+
+def cache_root() -> Path:
+    """``$ARA_CACHE``, else ``~/.cache/ara``."""
+    return Path(os.environ.get("ARA_CACHE", Path.home() / ".cache" / "ara"))
+
+
+def default_hf_dir() -> Path:
+    return cache_root() / "models" / "gemma-3-270m-hf"
+
+
+def is_prepared(folder: Path, gguf_sha256: str | None = None) -> bool:
+    """Whether ``folder`` holds a finished conversion (of that GGUF, if given)."""
+    path = folder / MANIFEST
+    if not path.is_file() or not (folder / "model.safetensors").is_file():
+        return False
+    return gguf_sha256 is None or json.loads(path.read_text())["gguf_sha256"] == gguf_sha256
+
+
+def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
+                       force: bool = False) -> Path:
+    """Convert a GGUF (the embedded Gemma 3 270M by default) into a HF folder.
+
+    Args:
+        out: Target folder; :func:`default_hf_dir` by default.
+        gguf_path: The GGUF to convert.
+        force: Convert again even if ``out`` already holds this conversion.
+
+    Returns:
+        The folder, loadable with ``from_pretrained(folder)``.
+    """
+    from ara.eval.backends.llama_cpp_backend import file_sha256
+    from ara.grammars.llama_check import default_model_path
+
+    gguf = Path(gguf_path or default_model_path())
+    if not gguf.is_file():
+        raise ModelPrepError(f"GGUF file not found: {gguf}")
+    out = out or default_hf_dir()
+    digest = file_sha256(str(gguf))
+    if not force and is_prepared(out, digest):
+        return out
+
+    import transformers
+    from transformers import AutoModelForCausalLM, AutoTokenizer
+
+    tokenizer = AutoTokenizer.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
+    loaded = AutoModelForCausalLM.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
+    # A GGUF-loaded model refuses save_pretrained; a fresh one with its weights does not.
+    model = type(loaded)(loaded.config)
+    missing, unexpected = model.load_state_dict(loaded.state_dict(), strict=False)
+    if unexpected or [k for k in missing if "lm_head" not in k]:
+        raise ModelPrepError(f"weights did not fit: missing {missing}, unexpected {unexpected}")
+    model.tie_weights()
+    staging = out.with_name(out.name + ".partial")
+    shutil.rmtree(staging, ignore_errors=True)
+    model.save_pretrained(staging)
+    tokenizer.save_pretrained(staging)
+    (staging / MANIFEST).write_text(json.dumps({
+        "gguf": gguf.name, "gguf_sha256": digest, "architecture": type(model).__name__,
+        "parameters": sum(p.numel() for p in model.parameters()),
+        "transformers_version": transformers.__version__, "ara_version": __version__,
+    }, indent=2, sort_keys=True) + "\n")
+    shutil.rmtree(out, ignore_errors=True)
+    staging.rename(out)
+    return out
