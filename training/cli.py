@@ -24,3 +24,18 @@ def prepare_cmd(
     with user_errors():
         folder = prepare_base_model(out, gguf, force)
     typer.echo(str(folder))
+
+
+def train_cmd(
+    config: Path = typer.Option(..., "--config", help="A run config, e.g. training/configs/*.yaml."),
+    max_steps: int = typer.Option(None, "--max-steps", help="Stop after N optimizer steps."),
+    resume: bool = typer.Option(False, "--resume", help="Continue from the newest checkpoint."),
+) -> None:
+    """LoRA fine-tuning (transformers + peft + accelerate) with the eval prompt format."""
+    import json
+
+    from ara.training.recipe import main
+
+    with user_errors():
+        summary = main(str(config), max_steps, resume)
+    typer.echo(json.dumps(summary, indent=2))

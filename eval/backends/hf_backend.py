@@ -42,6 +42,7 @@ class HFBackend:
 
         if mask not in MASK_ENGINES:
             raise BackendError(f"unknown mask engine {mask!r}; choose one of {MASK_ENGINES}")
+        self._torch = torch
         self.device = device or ("cuda" if torch.cuda.is_available() else "cpu")
         dtype = dtype or ("float32" if self.device == "cpu" else "bfloat16")
         try:
@@ -53,10 +54,24 @@ class HFBackend:
                 f"cannot load {model!r} locally ({err.__class__.__name__}); give a folder "
                 "(`ara model prepare` converts the embedded model) or a hub id already cached"
             ) from err
+        self._init_state(mask, f"hf:{Path(model).name}")
+
+    @classmethod
+    def from_objects(cls, model, tokenizer, model_id: str, mask: str = "llguidance") -> HFBackend:
+        """A backend around a model already in memory (e.g. a PEFT model being trained)."""
+        import torch
+
+        self = cls.__new__(cls)
+        self.model, self.tokenizer = model, tokenizer
+        self.device = next(model.parameters()).device.type
+        self._torch = torch
+        self._init_state(mask, model_id)
+        return self
+
+    def _init_state(self, mask: str, model_id: str) -> None:
         self.model.eval()
         self.mask = mask
-        self.model_id = f"hf:{Path(model).name}"
-        self._torch = torch
+        self.model_id = model_id
         eos = self.model.generation_config.eos_token_id
         self._eos = set(eos if isinstance(eos, list) else [eos]) | {self.tokenizer.eos_token_id}
         self._eos.discard(None)

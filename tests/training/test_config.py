@@ -1,0 +1,41 @@
+"""Run configs: YAML sections into dataclasses, clear errors, round trips."""
+
+from pathlib import Path
+
+import pytest
+
+from ara.errors import ConfigError
+from ara.training.config import TrainConfig
+
+CONFIGS = sorted(Path(__file__).parents[2].joinpath("training", "configs").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.name)
+def test_shipped_configs_load_and_round_trip(path):
+    """Tests every committed YAML config through load, to_dict and from_dict."""
+    config = TrainConfig.from_yaml(path)
+    assert TrainConfig.from_dict(config.to_dict()) == config
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ({"lora": {"alhpa": 8}}, r"unknown key lora.alhpa. Did you mean 'alpha'\?"),  # typo
+        ({"optimizer": {}}, "unknown key optimizer"),
+        ({"optim": {"lr": 0}}, "optim values out of range"),
+        ({"lora": {"dropout": 1.0}}, "0 <= dropout < 1"),
+        ({"data": {"forms": ["lifted", "raw"]}}, "lifted and/or grounded"),
+        ({"max_steps": 0}, "max_steps must be >= 1"),
+        ({"lora": 3}, "lora must be a mapping"),
+    ],
+)
+def test_bad_configs_say_what_is_wrong(data, message):
+    """Tests that misspelt keys and out-of-range values raise with the fix."""
+    with pytest.raises(ConfigError, match=message):
+        TrainConfig.from_dict(data)
+
+
+def test_missing_file_is_a_clear_error(tmp_path):
+    """Tests the message for a config path that does not exist."""
+    with pytest.raises(ConfigError, match="config file not found"):
+        TrainConfig.from_yaml(tmp_path / "nope.yaml")
