@@ -27,7 +27,8 @@ def prepare_cmd(
 
 
 def train_cmd(
-    config: Path = typer.Option(..., "--config", help="A run config, e.g. training/configs/*.yaml."),
+    config: Path = typer.Option(..., "--config",
+                                help="A run config, e.g. training/configs/*.yaml."),
     max_steps: int = typer.Option(None, "--max-steps", help="Stop after N optimizer steps."),
     resume: bool = typer.Option(False, "--resume", help="Continue from the newest checkpoint."),
 ) -> None:
