@@ -14,19 +14,12 @@ import json
 from pathlib import Path
 
 from ara.errors import DataVersionError
+from ara.hashing import sha256_file
 
 #: Bumped when the manifest's own layout changes.
 SCHEMA_VERSION = 1
 MANIFEST = "manifest.json"
 PARTS = ("train", "test")
-
-
-def sha256_file(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def uid_list_sha256(uids: list[str]) -> str:

@@ -27,6 +27,7 @@ from ara.data.normalize import (
 )
 from ara.data.splits import disjoint_split, given_split, overlap_stats, paper_split
 from ara.errors import ConfigError, DataVersionError, did_you_mean
+from ara.hashing import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
@@ -94,7 +95,7 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
         records, rejected = normalize_navi(rows)
         parts = (paper_split(records, len(rows), seed) if split == "paper"
                  else disjoint_split(records, seed))
-    sources = {name: mf.sha256_file(RAW_DIR / name) for name in files}
+    sources = {name: sha256_file(RAW_DIR / name) for name in files}
     return parts, rejected, sources
 
 

@@ -15,7 +15,7 @@ import platform
 import random
 import subprocess
 from collections.abc import Iterator
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 from ara import __version__
@@ -88,6 +88,10 @@ class AblationConfig:
         if self.form not in FORMS:
             raise ConfigError(f"unknown form {self.form!r}. {did_you_mean(self.form, FORMS)}")
         object.__setattr__(self, "variants", tuple(Variant.parse(v).name for v in self.variants))
+        if self.split == "timed" and not self.translator.intervals:
+            # NL2TL's timed formulas carry intervals: a grammar without them could not
+            # express a single reference.
+            object.__setattr__(self, "translator", replace(self.translator, intervals=True))
         if not self.variants or any(k < 1 for k in self.shots) or self.reruns < 1 or self.limit < 1:
             raise ConfigError(
                 "need at least one variant, shots >= 1, reruns >= 1 and limit >= 1; got "

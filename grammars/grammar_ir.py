@@ -106,7 +106,7 @@ class Grammar:
                 for r in self.rules}
         lines = []
         for rule in self.rules:
-            alts = " | ".join(_seq_text(seq, name, _gbnf_lit, _gbnf_chars) for seq in rule.alts)
+            alts = " | ".join(_seq_text(seq, name, _quote, _gbnf_chars) for seq in rule.alts)
             lines.append(f"{name[rule.name]} ::= {alts}")
         return "\n".join(lines) + "\n"
 
@@ -115,7 +115,7 @@ class Grammar:
         name = {r.name: ("start" if r.name == self.root else "r_" + r.name) for r in self.rules}
         lines = []
         for rule in self.rules:
-            alts = " | ".join(_seq_text(seq, name, _lark_lit, _lark_chars) for seq in rule.alts)
+            alts = " | ".join(_seq_text(seq, name, _quote, _lark_chars) for seq in rule.alts)
             lines.append(f"{name[rule.name]}: {alts}")
         return "\n".join(lines) + "\n"
 
@@ -261,11 +261,8 @@ def _escape(text: str) -> str:
     return text.replace("\\", "\\\\").replace('"', '\\"')
 
 
-def _gbnf_lit(text: str) -> str:
-    return f'"{_escape(text)}"'
-
-
-def _lark_lit(text: str) -> str:
+def _quote(text: str) -> str:
+    # GBNF and Lark quote literals alike.
     return f'"{_escape(text)}"'
 
 

@@ -40,3 +40,34 @@ def train_cmd(
     with user_errors():
         summary = main(str(config), max_steps, resume)
     typer.echo(json.dumps(summary, indent=2))
+
+
+def export_cmd(
+    run: Path = typer.Option(..., "--run", help="A finished `ara train` run folder."),
+    quant: str = typer.Option("f16,q8_0,q4_k_m", "--quant",
+                              help="Comma list of GGUF types: f32, f16, q8_0, q4_k_m, ..."),
+    lora_gguf: bool = typer.Option(False, "--lora-gguf", help="Also the adapter as GGUF LoRA."),
+    parity_pairs: int = typer.Option(20, "--parity",
+                                     help="Test pairs for the GGUF vs HF greedy check (0: skip)."),
+) -> None:
+    """Merge the adapter into the base, convert to GGUF, quantize, check parity."""
+    import json
+
+    from ara.cli_support import split_list
+    from ara.training.export import export_run, parity
+
+    with user_errors():
+        quants = split_list(quant)
+        outtype = "f32" if "f32" in quants else "f16"
+        manifest = export_run(run, quants, lora_gguf, outtype)
+        if parity_pairs:
+            from ara.data import load_split
+
+            config = json.loads((run / "run.json").read_text())["config"]
+            records = load_split(config["data"]["split"], config["data"]["seed"]).records(
+                "test", config["data"]["forms"][0])[:parity_pairs]
+            export = run / "export"
+            manifest["parity"] = parity(export / f"model-{outtype}.gguf", export / "merged-hf",
+                                        records)
+            (export / "export.json").write_text(json.dumps(manifest, indent=2) + "\n")
+    typer.echo(json.dumps(manifest, indent=2))

@@ -17,8 +17,11 @@ from pathlib import Path
 
 from ara import __version__
 from ara.errors import AraError
+from ara.hashing import sha256_file
 
 MANIFEST = "ara_model.json"
+#: Bumped when the folder's layout changes, so older conversions are redone.
+FORMAT = 2
 
 
 class ModelPrepError(AraError, RuntimeError):
@@ -39,7 +42,10 @@ def is_prepared(folder: Path, gguf_sha256: str | None = None) -> bool:
     path = folder / MANIFEST
     if not path.is_file() or not (folder / "model.safetensors").is_file():
         return False
-    return gguf_sha256 is None or json.loads(path.read_text())["gguf_sha256"] == gguf_sha256
+    manifest = json.loads(path.read_text())
+    if manifest.get("format") != FORMAT:
+        return False
+    return gguf_sha256 is None or manifest["gguf_sha256"] == gguf_sha256
 
 
 def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
@@ -54,14 +60,13 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     Returns:
         The folder, loadable with ``from_pretrained(folder)``.
     """
-    from ara.eval.backends.llama_cpp_backend import file_sha256
     from ara.grammars.llama_check import default_model_path
 
     gguf = Path(gguf_path or default_model_path())
     if not gguf.is_file():
         raise ModelPrepError(f"GGUF file not found: {gguf}")
     out = out or default_hf_dir()
-    digest = file_sha256(str(gguf))
+    digest = sha256_file(gguf)
     if not force and is_prepared(out, digest):
         return out
 
@@ -72,6 +77,10 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     loaded = AutoModelForCausalLM.from_pretrained(str(gguf.parent), gguf_file=gguf.name)
     # A GGUF-loaded model refuses save_pretrained; a fresh one with its weights does not.
     model = type(loaded)(loaded.config)
+    # The weights are plain float32 now; a leftover "quant_method: gguf" would make
+    # loaders and llama.cpp's converter look for quantized tensors.
+    if hasattr(model.config, "quantization_config"):
+        del model.config.quantization_config
     missing, unexpected = model.load_state_dict(loaded.state_dict(), strict=False)
     if unexpected or [k for k in missing if "lm_head" not in k]:
         raise ModelPrepError(f"weights did not fit: missing {missing}, unexpected {unexpected}")
@@ -81,7 +90,8 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     model.save_pretrained(staging)
     tokenizer.save_pretrained(staging)
     (staging / MANIFEST).write_text(json.dumps({
-        "gguf": gguf.name, "gguf_sha256": digest, "architecture": type(model).__name__,
+        "format": FORMAT, "gguf": gguf.name, "gguf_sha256": digest,
+        "architecture": type(model).__name__,
         "parameters": sum(p.numel() for p in model.parameters()),
         "transformers_version": transformers.__version__, "ara_version": __version__,
     }, indent=2, sort_keys=True) + "\n")

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ara.eval.backends.base import BackendError, Completion
-from ara.eval.backends.masking import GrammarMatcher
+from ara.eval.backends.masking import GrammarMatcher, greedy_decode
 from ara.grammars import BuiltGrammar
 
 MASK_ENGINES = ("llguidance", "outlines")
@@ -124,19 +124,9 @@ class HFBackend:
         ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
         logits, reused = self._feed_prompt(ids)
         matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
-        out: list[int] = []
-        text, reason = "", "length"
-        for _ in range(max_tokens):
-            token = matcher.choose(logits) if matcher else int(np.argmax(logits))
-            if token in self._eos:
-                reason = "eos"
-                break
-            out.append(token)
-            text = self.tokenizer.decode(out)
-            if matcher is None and stop in text:
-                text, reason = text[: text.index(stop)], "stop"
-                break
-            logits = self._forward([token])
+        text, out, reason = greedy_decode(
+            logits, lambda token: self._forward([token]), self.tokenizer.decode, matcher,
+            self._eos, max_tokens, stop)
         return Completion(text, len(ids), len(out), reused, (time.perf_counter() - start) * 1e3,
                           reason, matcher.masked_steps if matcher else 0)
 

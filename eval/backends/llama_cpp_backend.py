@@ -13,30 +13,20 @@ position once it has slid past it.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import time
 import warnings
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from ara.eval.backends.base import BackendError, Completion
-from ara.eval.backends.masking import GrammarMatcher
+from ara.eval.backends.masking import GrammarMatcher, greedy_decode
 from ara.grammars import BuiltGrammar
 from ara.grammars.llama_check import muted_llama_log
+from ara.hashing import sha256_file
 
 MASK_ENGINES = ("llguidance", "llama")
-
-
-@lru_cache(maxsize=8)
-def file_sha256(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 22), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 class LlamaCppBackend:
@@ -74,9 +64,9 @@ class LlamaCppBackend:
         except ValueError as err:
             raise BackendError(f"llama.cpp could not load {model_path}: {err}") from err
         self.mask = mask
-        self.model_id = f"gguf:{Path(model_path).name}:sha256:{file_sha256(str(model_path))[:16]}"
+        self.model_id = f"gguf:{Path(model_path).name}:sha256:{sha256_file(model_path)[:16]}"
         if lora_path:
-            self.model_id += f"+lora:sha256:{file_sha256(str(lora_path))[:16]}"
+            self.model_id += f"+lora:sha256:{sha256_file(lora_path)[:16]}"
         self._vocab = llama_cpp.llama_model_get_vocab(self.llm._model.model)
         self._eos = {self.llm.token_eos(), *self._end_of_turn()}
         self._lltokenizer = None
@@ -127,21 +117,16 @@ class LlamaCppBackend:
         if grammar is not None and self.mask == "llama":
             return self._complete_llama_grammar(grammar, max_tokens, len(tokens), reused, start)
         matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
-        out: list[int] = []
-        text, reason = b"", "length"
-        for _ in range(max_tokens):
-            logits = self._logits()
-            token = matcher.choose(logits) if matcher else int(np.argmax(logits))
-            if token in self._eos:
-                reason = "eos"
-                break
-            out.append(token)
-            text = self.llm.detokenize(out)
-            if matcher is None and stop.encode() in text:
-                text, reason = text[: text.index(stop.encode())], "stop"
-                break
+
+        def advance(token: int) -> np.ndarray:
             self.llm.eval([token])
-        return Completion(text.decode("utf-8", errors="replace"), len(tokens), len(out), reused,
+            return self._logits()
+
+        text, out, reason = greedy_decode(
+            self._logits(), advance,
+            lambda ids: self.llm.detokenize(ids).decode("utf-8", errors="replace"),
+            matcher, self._eos, max_tokens, stop)
+        return Completion(text, len(tokens), len(out), reused,
                           (time.perf_counter() - start) * 1e3, reason,
                           matcher.masked_steps if matcher else 0)
 

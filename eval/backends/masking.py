@@ -10,6 +10,7 @@ exactly the masked greedy choice either way.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -50,6 +51,37 @@ class GrammarMatcher:
     def done(self) -> bool:
         """Whether the grammar has ended (it accepted an end-of-sequence token)."""
         return self._matcher.is_stopped()
+
+
+def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
+                  detokenize: Callable[[list[int]], str], matcher: GrammarMatcher | None,
+                  eos: set[int], max_tokens: int, stop: str) -> tuple[str, list[int], str]:
+    """The greedy loop both local backends share.
+
+    Args:
+        logits: Scores after the prompt.
+        advance: Feeds one chosen token to the model, returns the next scores.
+        detokenize: Token ids to text.
+        matcher: The grammar's state, or ``None`` to decode freely until ``stop``.
+        eos: Tokens that end generation (the grammar allows them once it is complete).
+        max_tokens: Token budget.
+        stop: Free decoding ends at this string, which is not returned.
+
+    Returns:
+        ``(text, tokens, reason)`` with reason ``eos``, ``stop`` or ``length``.
+    """
+    out: list[int] = []
+    text = ""
+    for _ in range(max_tokens):
+        token = matcher.choose(logits) if matcher else int(np.argmax(logits))
+        if token in eos:
+            return text, out, "eos"
+        out.append(token)
+        text = detokenize(out)
+        if matcher is None and stop in text:
+            return text[: text.index(stop)], out, "stop"
+        logits = advance(token)
+    return text, out, "length"
 
 
 @lru_cache(maxsize=256)

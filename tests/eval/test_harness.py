@@ -55,3 +55,9 @@ def test_plan_covers_every_variant_shot_and_rerun_once():
     assert {j.examples for j in jobs if j.variant.name == "C"} == {()}
     rerun_examples = {j.rerun: j.examples for j in jobs if j.shots == 2}
     assert rerun_examples[0] != rerun_examples[1]  # examples are redrawn per rerun
+
+
+def test_timed_split_turns_intervals_on():
+    """Tests that the timed split's grammar can express its references."""
+    assert AblationConfig(split="timed").translator.intervals is True
+    assert AblationConfig(split="paper").translator.intervals is False

@@ -69,3 +69,24 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
     assert (adapter / "adapter_config.json").is_file()
     report = recipe.heldout_check()
     assert report["pairs"] == 2 and report["validity"] == 1.0
+
+
+@pytest.mark.slow  # converts and quantizes a 262k-vocabulary model: about a minute
+def test_export_gguf_loads_in_llama_cpp_and_agrees_with_hf(tiny_gemma_dir, tmp_path,
+                                                          paper_split):
+    """Tests train -> merge -> GGUF (f32) -> q8_0, the GGUF LoRA, and greedy parity."""
+    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.training.export import export_run, parity
+
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2)
+    recipe = LoRAFinetuneRecipe(config)
+    recipe.setup()
+    recipe.train()
+    recipe.save_adapter()
+    manifest = export_run(tmp_path / "run", ("f32", "q8_0"), lora_gguf=True, outtype="f32")
+    export = tmp_path / "run" / "export"
+    assert set(manifest["files"]) == {"model-f32.gguf", "model-q8_0.gguf", "lora.gguf"}
+    LlamaCppBackend(str(export / "model-q8_0.gguf"))  # loads
+    report = parity(export / "model-f32.gguf", export / "merged-hf",
+                    paper_split.records("test", "lifted")[:3], constrained=True)
+    assert report["agreement"] == 1.0, report

@@ -1,0 +1,156 @@
+"""From a LoRA run to GGUF files that llama.cpp serves, with a parity check.
+
+1. Merge the adapter into the *unquantized* base (never into a quantized model), and
+   save the merged model as a HF folder.
+2. Convert the merged folder to an f16 (or f32) GGUF with llama.cpp's own
+   ``convert_hf_to_gguf.py``, taken from the llama-cpp-python source package of the
+   version we run, so the converter and the runtime agree.
+3. Quantize with llama.cpp (``llama_model_quantize``) to q8_0, q4_k_m, ...
+4. Optionally convert the adapter alone to a GGUF LoRA (``convert_lora_to_gguf.py``),
+   a few MB that llama.cpp applies on top of the base GGUF.
+5. Write ``export.json``: hashes, base, run.
+
+``parity`` then checks that the exported GGUF, through llama-cpp-python, and the merged
+HF model give the same greedy formula on test pairs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tarfile
+from importlib.metadata import version
+from pathlib import Path
+
+from ara.errors import AraError
+from ara.hashing import sha256_file
+from ara.training.hf_model import cache_root
+
+#: llama.cpp quantization types by name (``llama_ftype`` values).
+QUANT_TYPES = {"f32": 0, "f16": 1, "q8_0": 7, "q4_k_m": 15, "q5_k_m": 17, "q6_k": 18}
+
+
+class ExportError(AraError, RuntimeError):
+    """An export step that failed, with what it ran."""
+
+
+def converter_dir() -> Path:
+    """llama.cpp's conversion scripts and gguf-py, extracted once from the sdist.
+
+    ``make setup`` calls this; the sdist comes from PyPI (the only network we use).
+    """
+    llama_version = version("llama-cpp-python")
+    folder = cache_root() / "tools" / f"llama.cpp-{llama_version}"
+    if (folder / "convert_hf_to_gguf.py").is_file():
+        return folder
+    download = cache_root() / "tools" / "sdist"
+    download.mkdir(parents=True, exist_ok=True)
+    subprocess.run([sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--no-binary",
+                    ":all:", "-d", str(download), f"llama-cpp-python=={llama_version}"],
+                   check=True)
+    (sdist,) = download.glob(f"llama_cpp_python-{llama_version}.tar.gz")
+    staging = folder.with_name(folder.name + ".partial")
+    prefix = f"llama_cpp_python-{llama_version}/vendor/llama.cpp/"
+    wanted = ("convert_hf_to_gguf.py", "convert_lora_to_gguf.py", "conversion/", "gguf-py/")
+    with tarfile.open(sdist) as tar:
+        members = [m for m in tar.getmembers()
+                   if m.name.startswith(prefix) and m.name[len(prefix):].startswith(wanted)]
+        for m in members:
+            m.name = m.name[len(prefix):]
+        tar.extractall(staging, members=members, filter="data")
+    staging.rename(folder)
+    return folder
+
+
+def _run_converter(script: str, args: list[str]) -> None:
+    tools = converter_dir()
+    env = {**os.environ, "PYTHONPATH": str(tools / "gguf-py")}
+    done = subprocess.run([sys.executable, str(tools / script), *args], env=env,
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        raise ExportError(f"{script} {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+
+
+def merge_adapter(base_dir: str, adapter_dir: str, out: Path) -> Path:
+    """The base with the LoRA merged in, saved as a HF folder (float32)."""
+    import torch
+    from peft import PeftModel
+    from transformers import AutoModelForCausalLM, AutoTokenizer
+
+    base = AutoModelForCausalLM.from_pretrained(base_dir, local_files_only=True,
+                                                dtype=torch.float32)
+    merged = PeftModel.from_pretrained(base, adapter_dir).merge_and_unload()
+    merged.save_pretrained(out)
+    AutoTokenizer.from_pretrained(adapter_dir).save_pretrained(out)
+    return out
+
+
+def to_gguf(hf_dir: Path, outfile: Path, outtype: str = "f16") -> Path:
+    """Convert a HF folder to one GGUF file (``outtype`` f32, f16 or bf16)."""
+    _run_converter("convert_hf_to_gguf.py", [str(hf_dir), "--outfile", str(outfile),
+                                             "--outtype", outtype])
+    return outfile
+
+
+def quantize(src: Path, dst: Path, quant: str) -> Path:
+    """Quantize a GGUF with llama.cpp."""
+    import llama_cpp
+
+    if quant not in QUANT_TYPES:
+        raise ExportError(f"unknown quantization {quant!r}; choose from {sorted(QUANT_TYPES)}")
+    params = llama_cpp.llama_model_quantize_default_params()
+    params.ftype = QUANT_TYPES[quant]
+    status = llama_cpp.llama_model_quantize(str(src).encode(), str(dst).encode(), params)
+    if status != 0:
+        raise ExportError(f"llama_model_quantize({src} -> {quant}) returned {status}")
+    return dst
+
+
+def lora_to_gguf(base_dir: str, adapter_dir: str, outfile: Path) -> Path:
+    """The adapter alone as a GGUF LoRA for llama.cpp."""
+    _run_converter("convert_lora_to_gguf.py", [adapter_dir, "--base", base_dir,
+                                               "--outfile", str(outfile), "--outtype", "f32"])
+    return outfile
+
+
+def export_run(run_dir: Path, quants: tuple[str, ...] = ("f16",), lora_gguf: bool = False,
+               outtype: str = "f16") -> dict:
+    """Export a finished training run (``ara train``) into ``run_dir/export``."""
+
+    run = json.loads((run_dir / "run.json").read_text())
+    base_dir, adapter = run["base_model"]["path"], str(run_dir / "adapter")
+    out = run_dir / "export"
+    out.mkdir(exist_ok=True)
+    merged = merge_adapter(base_dir, adapter, out / "merged-hf")
+    full = to_gguf(merged, out / f"model-{outtype}.gguf", outtype)
+    files = {full.name: full}
+    for quant in quants:
+        if quant != outtype:
+            files[f"model-{quant}.gguf"] = quantize(full, out / f"model-{quant}.gguf", quant)
+    if lora_gguf:
+        files["lora.gguf"] = lora_to_gguf(base_dir, adapter, out / "lora.gguf")
+    manifest = {"run": str(run_dir), "base_model": run["base_model"],
+                "config": run["config"], "data": run["data"],
+                "files": {name: {"sha256": sha256_file(p), "bytes": p.stat().st_size}
+                          for name, p in files.items()}}
+    (out / "export.json").write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n")
+    return manifest
+
+
+def parity(gguf: Path, hf_dir: Path, records, lora: Path | None = None,
+           constrained: bool = False) -> dict:
+    """Greedy answers of the GGUF (llama.cpp) and the HF folder (transformers), compared."""
+    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translator import Translator
+
+    llama = Translator(LlamaCppBackend(str(gguf), lora_path=str(lora) if lora else None))
+    hf = Translator(HFBackend(str(hf_dir)))
+    pairs = [(llama.translate(r.nl, r.aps, (), constrained=constrained).raw.strip(),
+              hf.translate(r.nl, r.aps, (), constrained=constrained).raw.strip())
+             for r in records]
+    agree = sum(a == b for a, b in pairs)
+    return {"pairs": len(pairs), "agree": agree, "agreement": agree / max(1, len(pairs)),
+            "disagreements": [p for p in pairs if p[0] != p[1]][:5]}
