@@ -18,7 +18,7 @@ test-all: setup  ## every test, slow ones included
 	$(BIN)/pytest $(PYTEST_ARGS)
 
 lint: setup
-	$(BIN)/ruff check ara grammars data tests bench
+	$(BIN)/ruff check ara grammars data eval training coordination tests bench
 
 bench: setup  ## measurements, printed as tables; not part of the tests
 	$(BIN)/python bench/spot_bounds.py

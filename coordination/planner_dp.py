@@ -1,0 +1,162 @@
+"""Exact per-robot planning of pick-and-place jobs: a DP over job subsets.
+
+For a robot's conjunction of PNP specs, the time to first satisfaction is the length of
+the best job order: start -> pick_1 -> drop_1 -> pick_2 -> ... on BFS distances (a job
+is done when its drop is reached; waiting never helps). The help job may also keep
+the helper ``dwell`` steps at its pick cell. Objectives:
+
+.. math::
+
+    \\text{makespan:}\\; M \\qquad
+    \\text{paper:}\\; D + T(\\varphi_{help}) + T(\\varphi_{new}) = 2M + t_{help} \\qquad
+    \\text{authors:}\\; T_{all} + D = 2M
+
+(Choe et al., Sec. IV; D is the path length, which equals M here.) Each is a sum of
+per-leg weights: a leg of d steps weighs 2d, plus d while the help job is not yet done
+(paper objective). So the DP over (done jobs, last job) is exact. It is the test oracle
+for the MILP and the fast path for experiments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ara.coordination.world import Cell, GridWorld
+from ara.errors import ConfigError
+
+OBJECTIVES = ("makespan", "paper", "authors")
+
+
+@dataclass(frozen=True)
+class Job:
+    """Pick something up at ``pick`` and put it down at ``drop``.
+
+    Args:
+        pick: Pick-up cell.
+        drop: Drop-off cell (may equal ``pick``).
+        dwell: Steps to stay at ``pick`` (the paper's tau_c for help tasks; 0 by default).
+        name: For messages and plots.
+    """
+
+    pick: Cell
+    drop: Cell
+    dwell: int = 0
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A robot's best job order, or why there is none.
+
+    Attributes:
+        status: ``optimal``, ``unreachable`` (a cell cannot be reached) or ``over_cap``
+            (the best makespan exceeds the cap).
+        order: Job indices in the order done.
+        completion: Step at which each job (by index) is done.
+        makespan: Steps until the last job is done (0 with no jobs).
+        objective: Value of the objective minimized.
+    """
+
+    status: str
+    order: tuple[int, ...] = ()
+    completion: tuple[int, ...] = ()
+    makespan: int = 0
+    objective: int = 0
+
+    @property
+    def feasible(self) -> bool:
+        return self.status == "optimal"
+
+
+def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "makespan",
+              help_index: int | None = None, cap: int | None = None) -> Plan:
+    """The optimal order of ``jobs`` for a robot at ``start``.
+
+    Args:
+        world: The grid.
+        start: The robot's cell.
+        jobs: Its jobs.
+        objective: ``makespan``, ``paper`` (needs ``help_index``) or ``authors``.
+        help_index: Which job is the help job.
+        cap: Largest allowed makespan, or ``None``.
+    """
+    if objective not in OBJECTIVES:
+        raise ConfigError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
+    if objective == "paper" and help_index is None:
+        raise ConfigError("the paper's objective weighs the help job: give help_index")
+    n = len(jobs)
+    if n == 0:
+        return Plan("optimal")
+    legs = _leg_lengths(world, start, jobs)
+    if legs is None:
+        return Plan("unreachable")
+    from_start, between = legs
+    help_bit = 0 if help_index is None else 1 << help_index
+
+    def weight(mask: int, d: int) -> int:
+        extra = d if objective == "paper" and not mask & help_bit else 0
+        return (d if objective == "makespan" else 2 * d) + extra
+
+    full = (1 << n) - 1
+    inf = float("inf")
+    # best[mask][j]: least cost with the jobs of mask done, j last; time[...]: its makespan
+    best = [[inf] * n for _ in range(1 << n)]
+    time = [[0] * n for _ in range(1 << n)]
+    parent: list[list[int]] = [[-1] * n for _ in range(1 << n)]
+    for j in range(n):
+        best[1 << j][j] = weight(0, from_start[j])
+        time[1 << j][j] = from_start[j]
+    for mask in range(1, full + 1):
+        for last in range(n):
+            cost = best[mask][last]
+            if cost == inf:
+                continue
+            for j in range(n):
+                if mask & (1 << j):
+                    continue
+                d = between[last][j]
+                nxt = mask | (1 << j)
+                c = cost + weight(mask, d)
+                if c < best[nxt][j]:
+                    best[nxt][j], time[nxt][j], parent[nxt][j] = c, time[mask][last] + d, last
+    last = min(range(n), key=lambda j: (best[full][j], time[full][j], j))
+    order = _unwind(parent, full, last)
+    completion = _completion_times(order, from_start, between)
+    makespan = max(completion)
+    if cap is not None and makespan > cap:
+        return Plan("over_cap", tuple(order), tuple(completion), makespan, int(best[full][last]))
+    return Plan("optimal", tuple(order), tuple(completion), makespan, int(best[full][last]))
+
+
+def _leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
+    """Steps from the start to finish each job, and from finishing one job to the next."""
+    def dist(a: Cell, b: Cell) -> int | None:
+        return world.distance(a, b) if world.is_free(a) and world.is_free(b) else None
+
+    own = [dist(job.pick, job.drop) for job in jobs]
+    to_pick = [[dist(a.drop, b.pick) for b in jobs] for a in jobs]
+    first = [dist(start, job.pick) for job in jobs]
+    if None in own or None in first or any(None in row for row in to_pick):
+        return None
+    from_start = [first[j] + jobs[j].dwell + own[j] for j in range(len(jobs))]
+    between = [[to_pick[i][j] + jobs[j].dwell + own[j] for j in range(len(jobs))]
+               for i in range(len(jobs))]
+    return from_start, between
+
+
+def _unwind(parent: list[list[int]], mask: int, last: int) -> list[int]:
+    order = []
+    while last != -1:
+        order.append(last)
+        mask, last = mask & ~(1 << last), parent[mask][last]
+    return order[::-1]
+
+
+def _completion_times(order: list[int], from_start: list[int],
+                      between: list[list[int]]) -> list[int]:
+    done = [0] * len(from_start)
+    t, prev = 0, None
+    for j in order:
+        t += from_start[j] if prev is None else between[prev][j]
+        done[j], prev = t, j
+    return done
