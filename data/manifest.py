@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 
 from ara.errors import DataVersionError
-from ara.hashing import sha256_file
+from ara.provenance import sha256_file
 
 #: Bumped when the manifest's own layout changes.
 SCHEMA_VERSION = 1

@@ -27,7 +27,7 @@ from ara.data.normalize import (
 )
 from ara.data.splits import disjoint_split, given_split, overlap_stats, paper_split
 from ara.errors import ConfigError, DataVersionError, did_you_mean
-from ara.hashing import sha256_file
+from ara.provenance import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"

@@ -13,10 +13,8 @@ from __future__ import annotations
 import os
 import platform
 import random
-import subprocess
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field, fields, replace
-from pathlib import Path
 
 from ara import __version__
 from ara.data import PreparedSplit, Record
@@ -26,6 +24,7 @@ from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
+from ara.provenance import git_commit
 
 LETTERS = {"F": "few_shot", "P": "grammar_in_prompt", "C": "constrained"}
 
@@ -199,16 +198,7 @@ def run_metadata(config: AblationConfig, split: PreparedSplit, model_id: str) ->
         "grammar_version": GRAMMAR_VERSION,
         "seed": config.seed,
         "ara_version": __version__,
-        "git_commit": _git_commit(),
+        "git_commit": git_commit(),
         "machine": {"platform": platform.platform(), "processor": platform.machine(),
                     "cpus": os.cpu_count()},
     }
-
-
-def _git_commit() -> str | None:
-    try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                             cwd=Path(__file__).parent, timeout=10)
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    return out.stdout.strip() or None

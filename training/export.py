@@ -25,7 +25,7 @@ from importlib.metadata import version
 from pathlib import Path
 
 from ara.errors import AraError
-from ara.hashing import sha256_file
+from ara.provenance import sha256_file
 from ara.training.hf_model import cache_root
 
 #: llama.cpp quantization types by name (``llama_ftype`` values).

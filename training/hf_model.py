@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ara import __version__
 from ara.errors import AraError
-from ara.hashing import sha256_file
+from ara.provenance import sha256_file
 
 MANIFEST = "ara_model.json"
 #: Bumped when the folder's layout changes, so older conversions are redone.

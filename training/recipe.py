@@ -108,13 +108,13 @@ class LoRAFinetuneRecipe:
         return max(0.0, (self.total_steps - step) / max(1, self.total_steps - warm))
 
     def _provenance(self) -> dict:
-        from ara.eval.harness import _git_commit
         from ara.grammars import GRAMMAR_VERSION
+        from ara.provenance import git_commit
 
         manifest = Path(self.model_dir, "ara_model.json")
         base_hash = json.loads(manifest.read_text())["gguf_sha256"] if manifest.exists() else None
         return {"config": self.config.to_dict(), "ara_version": __version__,
-                "git_commit": _git_commit(), "grammar_version": GRAMMAR_VERSION,
+                "git_commit": git_commit(), "grammar_version": GRAMMAR_VERSION,
                 "data": {"split": self.config.data.split, "version": self.split.version,
                          "train_examples": len(self.train_examples)},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},

@@ -24,7 +24,7 @@ from ara.eval.backends.base import BackendError, Completion
 from ara.eval.backends.masking import GrammarMatcher, greedy_decode
 from ara.grammars import BuiltGrammar
 from ara.grammars.llama_check import muted_llama_log
-from ara.hashing import sha256_file
+from ara.provenance import sha256_file
 
 MASK_ENGINES = ("llguidance", "llama")
 

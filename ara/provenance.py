@@ -1,9 +1,10 @@
-"""Content hashes of files, the provenance every artifact records."""
+"""What every artifact records about what produced it: file hashes, the git commit."""
 
 from __future__ import annotations
 
 import hashlib
 import os
+import subprocess
 from functools import lru_cache
 from pathlib import Path
 
@@ -21,3 +22,13 @@ def _sha256(path: str, size: int, mtime_ns: int) -> str:
         for block in iter(lambda: fh.read(1 << 22), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+def git_commit() -> str | None:
+    """The commit of the checkout this code runs from, or ``None`` outside git."""
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                             cwd=Path(__file__).parent, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return out.stdout.strip() or None
