@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 
 from ara.errors import ConfigError, STLSyntaxError
 from ara.eval.backends.base import Backend
@@ -99,6 +100,12 @@ class TranslationResult:
         return data
 
 
+@lru_cache(maxsize=1024)
+def decoding_grammar(built: BuiltGrammar) -> BuiltGrammar:
+    """The grammar decoding runs under: the answer prefix, then a formula of ``built``."""
+    return BuiltGrammar(built.syntax, built.grammar.with_prefix(ANSWER_PREFIX))
+
+
 class Translator:
     """Translate instructions with one backend.
 
@@ -130,7 +137,7 @@ class Translator:
         shown = grammar_for_prompt(built.syntax) if grammar_in_prompt else None
         prompt = build_prompt(nl, aps, shots, shown)
         if constrained:
-            decoding = BuiltGrammar(built.syntax, built.grammar.with_prefix(ANSWER_PREFIX))
+            decoding = decoding_grammar(built)
             budget = int(decoding.grammar.max_length()) + 1
             completion = self.backend.complete(prompt, decoding, budget, STOP)
         else:

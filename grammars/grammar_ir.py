@@ -9,6 +9,7 @@ string of the language is longer than ``max_length()`` characters.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import random
@@ -65,6 +66,20 @@ class Rule:
     alts: tuple[Seq, ...]
 
 
+def _memoized(method):
+    """Cache a no-argument method's result on the (immutable) grammar instance."""
+    name = method.__name__
+
+    @functools.wraps(method)
+    def wrapper(self):
+        memo = self.__dict__.setdefault("_memo", {})
+        if name not in memo:
+            memo[name] = method(self)
+        return memo[name]
+
+    return wrapper
+
+
 @dataclass(frozen=True)
 class Grammar:
     """A grammar: its rules and the name of the start rule.
@@ -100,6 +115,7 @@ class Grammar:
         rules = (Rule(name, ((Lit(text), Ref(self.root)),)), *self.rules)
         return Grammar(rules, root=name)
 
+    @_memoized
     def to_gbnf(self) -> str:
         """The grammar in llama.cpp's GBNF; the start rule is named ``root``."""
         name = {r.name: ("root" if r.name == self.root else _gbnf_name(r.name))
@@ -110,6 +126,7 @@ class Grammar:
             lines.append(f"{name[rule.name]} ::= {alts}")
         return "\n".join(lines) + "\n"
 
+    @_memoized
     def to_lark(self) -> str:
         """The grammar in Lark syntax (outlines, llguidance); the start rule is ``start``."""
         name = {r.name: ("start" if r.name == self.root else "r_" + r.name) for r in self.rules}
@@ -119,14 +136,17 @@ class Grammar:
             lines.append(f"{name[rule.name]}: {alts}")
         return "\n".join(lines) + "\n"
 
+    @_memoized
     def sha256(self) -> str:
         """Content hash of the grammar (of its GBNF text)."""
         return hashlib.sha256(self.to_gbnf().encode()).hexdigest()
 
+    @_memoized
     def min_lengths(self) -> dict[str, int]:
         """Length in characters of each rule's shortest derivation."""
         return _min_lengths(self)
 
+    @_memoized
     def max_length(self) -> float:
         """Length of the longest string in the language (``math.inf`` when unbounded)."""
         return _max_length(self)

@@ -9,7 +9,7 @@ grammar holds no ambiguity that would multiply a decoder's parse stacks.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 from ara.errors import ConfigError
@@ -73,11 +73,18 @@ def _build_cached(syntax: Syntax) -> BuiltGrammar:
     # Longest names first keeps the emitted alternatives readable; order has no
     # effect on the language.
     names = sorted(syntax.aps, key=lambda n: (-len(n), n))
-    rules = [Rule("atom", tuple((Lit(n),) for n in ("true", "false", *names)))]
-    if syntax.intervals:
-        rules += interval_rules(syntax.max_bound, syntax.allow_inf)
-    rules += _relaxed_rules(syntax) if syntax.relaxed else _canonical_rules(syntax)
-    return BuiltGrammar(syntax, Grammar(tuple(rules), root="root"))
+    atom = Rule("atom", tuple((Lit(n),) for n in ("true", "false", *names)))
+    structure = _structure_rules(replace(syntax, aps=None))
+    return BuiltGrammar(syntax, Grammar((atom, *structure), root="root"))
+
+
+@lru_cache(maxsize=64)
+def _structure_rules(layout: Syntax) -> tuple[Rule, ...]:
+    """Every rule but ``atom``: they depend on the layout, never on the propositions,
+    so requests with new propositions reuse them."""
+    rules = interval_rules(layout.max_bound, layout.allow_inf) if layout.intervals else []
+    rules += _relaxed_rules(layout) if layout.relaxed else _canonical_rules(layout)
+    return tuple(rules)
 
 
 def _canonical_rules(syntax: Syntax) -> list[Rule]:
