@@ -18,7 +18,8 @@ def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
     tokenizer = AutoTokenizer.from_pretrained(hf_model_dir)
     config = Gemma3TextConfig(vocab_size=len(tokenizer), hidden_size=32, intermediate_size=64,
                               num_hidden_layers=2, num_attention_heads=2, num_key_value_heads=1,
-                              head_dim=16, sliding_window=64, max_position_embeddings=1024)
+                              head_dim=16, query_pre_attn_scalar=16, sliding_window=64,
+                              max_position_embeddings=1024)  # scalar = head_dim, as in Gemma 3
     folder = tmp_path_factory.mktemp("tiny-gemma")
     Gemma3ForCausalLM(config).save_pretrained(folder)
     tokenizer.save_pretrained(folder)
@@ -72,11 +73,18 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
 
 
 @pytest.mark.slow  # converts and quantizes a 262k-vocabulary model: about a minute
-def test_export_gguf_loads_in_llama_cpp_and_agrees_with_hf(tiny_gemma_dir, tmp_path,
-                                                          paper_split):
-    """Tests train -> merge -> GGUF (f32) -> q8_0, the GGUF LoRA, and greedy parity."""
+def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tmp_path):
+    """Tests train -> merge -> GGUF (f32) -> q8_0 and the GGUF LoRA, then that llama.cpp
+    and transformers compute the same next-token scores from the exported weights.
+
+    Random weights give near-uniform scores, so greedy answers are a coin toss under any
+    rounding; the score vectors themselves must still agree.
+    """
+    import numpy as np
+
+    from ara.eval.backends.hf_backend import HFBackend
     from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-    from ara.training.export import export_run, parity
+    from ara.training.export import export_run
 
     config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2)
     recipe = LoRAFinetuneRecipe(config)
@@ -87,6 +95,12 @@ def test_export_gguf_loads_in_llama_cpp_and_agrees_with_hf(tiny_gemma_dir, tmp_p
     export = tmp_path / "run" / "export"
     assert set(manifest["files"]) == {"model-f32.gguf", "model-q8_0.gguf", "lora.gguf"}
     LlamaCppBackend(str(export / "model-q8_0.gguf"))  # loads
-    report = parity(export / "model-f32.gguf", export / "merged-hf",
-                    paper_split.records("test", "lifted")[:3], constrained=True)
-    assert report["agreement"] == 1.0, report
+    llama = LlamaCppBackend(str(export / "model-f32.gguf"))
+    hf = HFBackend(str(export / "merged-hf"))
+    prompt = "NL: always (prop_1)\nPropositions: prop_1\nSTL:"
+    tokens = llama.llm.tokenize(prompt.encode(), add_bos=True, special=False)
+    assert tokens == hf.tokenizer(prompt, add_special_tokens=True)["input_ids"]
+    llama._feed_prompt(tokens)
+    ours = llama._logits().copy()
+    theirs, _ = hf._feed_prompt(tokens)
+    assert np.corrcoef(ours, theirs)[0, 1] > 0.999
