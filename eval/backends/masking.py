@@ -47,11 +47,6 @@ class GrammarMatcher:
             raise RuntimeError(f"llguidance refused its own mask: {self._matcher.get_error()}")
         return token
 
-    @property
-    def done(self) -> bool:
-        """Whether the grammar has ended (it accepted an end-of-sequence token)."""
-        return self._matcher.is_stopped()
-
 
 def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
                   detokenize: Callable[[list[int]], str], matcher: GrammarMatcher | None,

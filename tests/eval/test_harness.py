@@ -2,7 +2,6 @@
 
 import pytest
 
-from ara.data import load_split, prepare
 from ara.errors import ConfigError
 from ara.eval.harness import AblationConfig, Variant, plan
 
@@ -40,12 +39,9 @@ def test_config_round_trips_and_refuses_unknown_keys():
         AblationConfig(split="disjont")
 
 
-def test_plan_covers_every_variant_shot_and_rerun_once():
+def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):
     """Tests the plan's size, uniqueness, and shared examples within a run."""
-    try:
-        split = load_split("paper")
-    except ValueError:
-        split = prepare("paper")
+    split = paper_split
     config = AblationConfig(variants=("F", "F+P+C", "C"), shots=(2, 3), reruns=2, limit=4)
     jobs = list(plan(config, split))
     assert len(jobs) == 2 * (2 * 2 + 1) * 4  # reruns x (F variants x shots + zero-shot C) x pairs
