@@ -22,6 +22,7 @@ lint: setup
 
 bench: setup  ## measurements, printed as tables; not part of the tests
 	$(BIN)/python bench/spot_bounds.py
+	$(BIN)/python bench/coord_planners.py
 
 clean:
 	rm -rf data/prepared .pytest_cache

@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 
 from ara import __version__
+from ara.coordination.cli import coord_app
 from ara.data.cli import data_app
 from ara.demo import demo_cmd
 from ara.eval.cli import eval_app, translate_cmd
@@ -21,6 +22,7 @@ app.add_typer(stl_app, name="stl")
 app.add_typer(data_app, name="data")
 app.add_typer(eval_app, name="eval")
 app.add_typer(model_app, name="model")
+app.add_typer(coord_app, name="coord")
 app.command("translate")(translate_cmd)
 app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)

@@ -14,7 +14,8 @@ the helper ``dwell`` steps at its pick cell. Objectives:
 (Choe et al., Sec. IV; D is the path length, which equals M here.) Each is a sum of
 per-leg weights: a leg of d steps weighs 2d, plus d while the help job is not yet done
 (paper objective). So the DP over (done jobs, last job) is exact. It is the test oracle
-for the MILP and the fast path for experiments.
+for the MILP and the fast path for experiments. Among equally good orders it returns
+one with the least makespan (both are sums over legs, so the pair orders exactly).
 """
 
 from __future__ import annotations
@@ -117,7 +118,9 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
                 d = between[last][j]
                 nxt = mask | (1 << j)
                 c = cost + weight(mask, d)
-                if c < best[nxt][j]:
+                # ties go to the shorter makespan, as in the MILP's objective
+                if c < best[nxt][j] or (c == best[nxt][j]
+                                        and time[mask][last] + d < time[nxt][j]):
                     best[nxt][j], time[nxt][j], parent[nxt][j] = c, time[mask][last] + d, last
     last = min(range(n), key=lambda j: (best[full][j], time[full][j], j))
     order = _unwind(parent, full, last)

@@ -145,6 +145,21 @@ class GridWorld:
             cache[source] = dist
         return cache[source]
 
+    def path(self, a: Cell, b: Cell) -> list[Cell]:
+        """A shortest path from ``a`` to ``b``, both ends included (BFS order, so the
+        same every time).
+
+        Raises:
+            WorldError: No path.
+        """
+        dist = self._bfs(b)
+        if a not in dist:
+            raise WorldError(f"no path from {a} to {b}")
+        out = [a]
+        while out[-1] != b:  # step to any neighbour one closer to b, in the fixed order
+            out.append(next(n for n in self.neighbors(out[-1]) if dist.get(n) == dist[out[-1]] - 1))
+        return out
+
     def nearest_free_neighbour(self, cell: Cell) -> Cell:
         """The first free 4-neighbour in the order up, down, left, right.
 

@@ -93,9 +93,38 @@ def test_data_prepare_and_stats(tmp_path):
 @pytest.mark.parametrize(
     "command",
     [[], ["stl"], ["stl", "parse"], ["stl", "equiv"], ["stl", "implies"], ["grammar"],
-     ["data"], ["data", "prepare"], ["data", "stats"], ["data", "export"], ["demo"]],
+     ["data"], ["data", "prepare"], ["data", "stats"], ["data", "export"], ["demo"],
+     ["coord"], ["coord", "exp2"], ["coord", "demo"], ["coord", "plan"]],
 )
 def test_every_command_explains_itself(command):
     """Tests that --help works everywhere and says something."""
     result = runner.invoke(app, command + ["--help"], env={**os.environ, "COLUMNS": "120"})
     assert result.exit_code == 0 and "Usage" in result.output and len(result.output) > 200
+
+
+@pytest.mark.parametrize("name", ["pallet", "kitting", "tool"])
+def test_coord_demos_print_messages_stl_plan_and_a_picture(name, tmp_path):
+    out = ara("coord", "demo", name, "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    assert "STL" in out.stdout and (tmp_path / f"{name}.png").stat().st_size > 1000
+    result = json.loads((tmp_path / f"{name}.json").read_text())
+    if name == "pallet":
+        assert "accept" in out.stdout and result["chosen"] is not None
+    else:
+        assert "[plan]" in out.stdout and result["status"] == "optimal"
+
+
+def test_coord_plan_and_its_errors(tmp_path):
+    out = ara("coord", "plan", "!b U (a & F b)", "--at", "a=0,7", "--at", "b=7,7", "--json")
+    plan = json.loads(out.stdout)
+    assert out.returncode == 0 and plan["order"] == ["a", "b"] and plan["makespan"] == 14
+    out = ara("coord", "plan", "F[0,2] a", "--at", "a=7,7")
+    assert out.returncode == 1 and out.stdout.startswith("infeasible")
+    out = ara("coord", "plan", "F a | F b", "--at", "a=0,7", "--at", "b=7,7")
+    assert out.returncode == 2 and "cannot plan for" in out.stderr
+    bad = tmp_path / "bad.txt"
+    bad.write_text("..\n.x\n")
+    out = ara("coord", "plan", "F a", "--at", "a=0,0", "--world", str(bad))
+    assert out.returncode == 2 and "bad.txt:2:2: unexpected 'x'" in out.stderr
+    out = ara("coord", "exp2", "--out", str(tmp_path / "e"), "--llm", "default")
+    assert out.returncode == 2 and "--planner milp" in out.stderr

@@ -69,19 +69,40 @@ def batches(examples: Sequence[Example], batch_size: int, seed: int, epoch: int,
         yield [examples[i] for i in order[start: start + batch_size]]
 
 
-def answer_loss(model, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+def shared_prefix_length(batch: dict[str, torch.Tensor]) -> int:
+    """How many leading tokens every row of ``batch`` has in common (all unpadded)."""
+    ids, mask = batch["input_ids"], batch["attention_mask"]
+    same = (ids == ids[:1]).all(dim=0) & mask.bool().all(dim=0)
+    differs = (~same).nonzero()
+    return int(differs[0]) if len(differs) else ids.shape[1]
+
+
+def answer_loss(model, batch: dict[str, torch.Tensor], share_prefix: bool = True) -> torch.Tensor:
     """Mean cross-entropy over answer tokens, computing the vocabulary head only there.
 
     Gemma's output layer (262k x hidden) costs more than the rest of a 270M model; the
     logits at position t predict token t+1, so only the positions right before an
     answer token are kept (``logits_to_keep`` with those indices).
+
+    Every prompt starts with the same instructions, about half of a training sequence.
+    With ``share_prefix`` that common prefix runs once, for one row, and its keys and
+    values are repeated across the batch: the same loss and the same gradients (the
+    repeat sums them back), at about half the compute.
     """
     labels = batch["labels"]
     targets = labels[:, 1:]
     keep = (targets != IGNORE).any(dim=0).nonzero().squeeze(1)
-    out = model(input_ids=batch["input_ids"], attention_mask=batch["attention_mask"],
-                logits_to_keep=keep)
-    logits = out.logits  # (batch, len(keep), vocab)
     gathered = targets[:, keep]
+    ids, mask = batch["input_ids"], batch["attention_mask"]
+    shared = min(shared_prefix_length(batch), int(keep.min())) if share_prefix else 0
+    if shared < 2 or ids.shape[0] == 1:
+        out = model(input_ids=ids, attention_mask=mask, logits_to_keep=keep)
+    else:
+        prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
+        cache = prefix.past_key_values
+        cache.batch_repeat_interleave(ids.shape[0])
+        out = model(input_ids=ids[:, shared:], attention_mask=mask, past_key_values=cache,
+                    logits_to_keep=keep - shared)
+    logits = out.logits  # (batch, len(keep), vocab)
     return torch.nn.functional.cross_entropy(
         logits.float().reshape(-1, logits.shape[-1]), gathered.reshape(-1), ignore_index=IGNORE)

@@ -104,3 +104,35 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
     ours = llama._logits().copy()
     theirs, _ = hf._feed_prompt(tokens)
     assert np.corrcoef(ours, theirs)[0, 1] > 0.999
+
+
+def test_sharing_the_prompt_prefix_gives_the_same_loss_and_gradients(tiny_gemma_dir):
+    """The instructions every prompt starts with run once per batch; loss and LoRA
+    gradients must match a plain forward over the whole batch."""
+    import torch
+    from peft import LoraConfig, get_peft_model
+    from transformers import AutoModelForCausalLM, AutoTokenizer
+
+    from ara.data import load_split
+    from ara.training.dataset import answer_loss, collate, encode, shared_prefix_length
+
+    tokenizer = AutoTokenizer.from_pretrained(tiny_gemma_dir)
+    records = load_split("paper", 0).records("train", "lifted")[:4]
+    batch = collate(encode(records, tokenizer), tokenizer.pad_token_id)
+    assert 20 < shared_prefix_length(batch) < batch["input_ids"].shape[1]
+    torch.manual_seed(0)
+    model = get_peft_model(AutoModelForCausalLM.from_pretrained(tiny_gemma_dir),
+                           LoraConfig(r=4, lora_alpha=8, target_modules="all-linear",
+                                      init_lora_weights=False))
+
+    def loss_and_grads(share):
+        model.zero_grad()
+        loss = answer_loss(model, batch, share_prefix=share)
+        loss.backward()
+        return loss.item(), [p.grad.clone() for p in model.parameters() if p.requires_grad]
+
+    plain_loss, plain_grads = loss_and_grads(False)
+    shared_loss, shared_grads = loss_and_grads(True)
+    assert shared_loss == pytest.approx(plain_loss, rel=1e-5)
+    for a, b in zip(plain_grads, shared_grads, strict=True):
+        torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-6)

@@ -1,0 +1,118 @@
+"""``ara coord ...``: the help protocol, its planners, and the paper's Experiment 2."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+from ara.cli_support import user_errors
+
+coord_app = typer.Typer(help="Multi-robot help requests: Experiment 2, demos, planning.",
+                        no_args_is_help=True)
+
+
+def _translator(llm: str):
+    """None for --llm none; else the eval translator over that model."""
+    if llm == "none":
+        return None
+    from ara.eval.models import make_backend
+    from ara.eval.translator import Translator
+
+    return Translator(make_backend(llm))
+
+
+@coord_app.command("exp2")
+def exp2_cmd(
+    out: Path = typer.Option(..., "--out", help="Run folder (resumed if it exists)."),
+    trials: int = typer.Option(100, "--trials", help="Number of trials."),
+    seed: int = typer.Option(3000, "--seed", help="Seed of trial 0; trial i uses seed + i."),
+    planner: str = typer.Option("dp", "--planner",
+                                help="dp (exact, fast) or milp (the STL->MILP compiler)."),
+    llm: str = typer.Option("none", "--llm",
+                            help="none: helpers use the template help spec; else a model "
+                                 "(default, finetuned, FILE.gguf, hf:DIR) that translates "
+                                 "each request (needs --planner milp)."),
+    solver: str = typer.Option("highs", "--solver", help="MILP solver: highs or gurobi."),
+    objective: str = typer.Option("paper", "--objective",
+                                  help="Helper objective: paper (D + T_help + T_new) or "
+                                       "authors (T_all + D)."),
+    ils_iterations: int = typer.Option(100, "--ils-iterations", help="Oracle ILS rounds."),
+    jobs: int = typer.Option(1, "--jobs", help="Parallel trials (joblib processes)."),
+) -> None:
+    """Reproduce the paper's Experiment 2: trials.csv, summary.json, boxplot.png in OUT."""
+    from ara.coordination.experiment2 import Exp2Config, run, table
+
+    with user_errors():
+        config = Exp2Config(trials=trials, seed=seed, planner=planner, llm=llm, solver=solver,
+                            objective=objective, ils_iterations=ils_iterations)
+        if solver != "highs":
+            from ara.coordination.milp import make_solver
+
+            make_solver(solver)  # fails now, with its reason, rather than in a worker
+        factory = (lambda: _translator(llm)) if llm != "none" else None
+        summary = run(config, out, jobs, factory)
+    typer.echo(table(summary))
+    typer.echo(json.dumps(summary["comparisons"], indent=2))
+    typer.echo(f"wrote {out}/trials.csv, summary.json, boxplot.png")
+
+
+@coord_app.command("demo")
+def demo_cmd(
+    name: str = typer.Argument(..., help="pallet, kitting or tool."),
+    out: Path = typer.Option(Path("runs/demos"), "--out", help="Folder for the PNG and JSON."),
+    llm: str = typer.Option("none", "--llm",
+                            help="none: the reference STL; else a model that translates."),
+) -> None:
+    """Run one of the paper's demonstrations: messages, STL, plan, and a PNG of the paths."""
+    from ara.coordination.demos import run_demo
+
+    with user_errors():
+        run_demo(name, out, _translator(llm), typer.echo)
+
+
+@coord_app.command("plan")
+def plan_cmd(
+    stl: str = typer.Argument(..., help="A formula over the names given with --at."),
+    at: list[str] = typer.Option(..., "--at", help="NAME=ROW,COL for each event, repeatable."),
+    start: str = typer.Option("0,0", "--start", help="ROW,COL of the robot."),
+    world_file: Path = typer.Option(None, "--world", help="World file [default: paper 8x8]."),
+    objective: str = typer.Option("makespan", "--objective", help="makespan or authors."),
+    cap: int = typer.Option(None, "--cap", help="Largest makespan allowed."),
+    solver: str = typer.Option("highs", "--solver", help="highs or gurobi."),
+    as_json: bool = typer.Option(False, "--json", help="One JSON object."),
+) -> None:
+    """Plan a robot's path for an STL spec with the event MILP (no plan: exit 1)."""
+    from dataclasses import asdict
+
+    from ara.cli_support import emit
+    from ara.coordination.events import Vocabulary
+    from ara.coordination.milp import make_solver
+    from ara.coordination.planner_milp import plan_spec
+    from ara.coordination.world import GridWorld
+    from ara.errors import ConfigError
+    from ara.grammars import parse
+
+    def cell(text: str):
+        try:
+            r, c = (int(x) for x in text.split(","))
+        except ValueError:
+            raise ConfigError(f"a cell is ROW,COL, got {text!r}") from None
+        return r, c
+
+    with user_errors():
+        world = GridWorld.from_file(world_file) if world_file else GridWorld.paper()
+        places = {}
+        for item in at:
+            name, _, where = item.partition("=")
+            if not where:
+                raise ConfigError(f"--at takes NAME=ROW,COL, got {item!r}")
+            places[name] = cell(where)
+        plan = plan_spec(world, cell(start), {"task": parse(stl)}, Vocabulary(places),
+                         objective, cap, make_solver(solver))
+    emit(asdict(plan), as_json, lambda p: (
+        f"{p['status']}: " + " -> ".join(f"{e}@{p['times'][e]}" for e in p["order"])
+        + f"  makespan {p['makespan']}, {p['solve_s'] * 1000:.1f} ms"))
+    if not plan.feasible:
+        raise typer.Exit(1)

@@ -1,0 +1,332 @@
+"""The centralized Oracle: all jobs over all robots, with full knowledge.
+
+The problem (the paper's B1): robots at distinct starts, pick-and-place jobs each done
+in one go (pick, carry, place), open routes, a makespan cap per robot. The cost is
+``J = sum of makespans + the requester's wait`` (the completion time of the help job,
+when there is one). Two solvers:
+
+- :func:`ils`: the paper's appendix, GreedyInsertion then iterated local search
+  (perturb, local search, accept if better or with probability exp(-(J'-J)/T), keep
+  the best);
+- :func:`exact`: a MILP over job successions (HiGHS by default) that proves the
+  optimum, the physical limit the ILS is measured against. ``pinned`` fixes jobs to
+  robots (baseline B3).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+from ara.coordination.milp import LinearModel, MILPSolver, make_solver
+from ara.coordination.planner_dp import Job
+from ara.coordination.world import Cell, GridWorld
+from ara.errors import AraError
+
+OVER_CAP_PENALTY = 1000
+
+
+class FleetError(AraError, ValueError):
+    """A fleet problem with cells that are not free or jobs no robot can reach."""
+
+
+@dataclass(frozen=True)
+class Fleet:
+    """Robots, jobs, and which job (if any) someone is waiting for.
+
+    Args:
+        world: The grid.
+        starts: Each robot's cell.
+        jobs: All jobs.
+        help_job: Index of the help job in ``jobs``; its completion time is added to J.
+        cap: Largest makespan allowed per robot.
+    """
+
+    world: GridWorld
+    starts: tuple[Cell, ...]
+    jobs: tuple[Job, ...]
+    help_job: int | None = None
+    cap: int | None = 50
+
+    @cached_property
+    def legs(self) -> tuple[list[list[int]], list[list[int]]]:
+        """``first[k][j]``: robot k's steps to finish job j first; ``then[i][j]``:
+        steps to finish j right after i."""
+        w = self.world
+
+        def d(a: Cell, b: Cell) -> int:
+            dist = w.distance(a, b) if w.is_free(a) and w.is_free(b) else None
+            if dist is None:
+                raise FleetError(f"no path from {a} to {b}")
+            return dist
+
+        own = [j.dwell + d(j.pick, j.drop) for j in self.jobs]
+        first = [[d(s, j.pick) + own[x] for x, j in enumerate(self.jobs)] for s in self.starts]
+        then = [[d(a.drop, b.pick) + own[y] for y, b in enumerate(self.jobs)] for a in self.jobs]
+        return first, then
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Each robot's jobs in order, and what they cost."""
+
+    routes: tuple[tuple[int, ...], ...]
+    makespans: tuple[int, ...]
+    help_time: int
+    cost: int  # sum of makespans + help_time
+    feasible: bool  # every makespan within the cap
+    status: str = "heuristic"
+    solve_s: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def total_makespan(self) -> int:
+        return sum(self.makespans)
+
+
+def evaluate(fleet: Fleet, routes: Sequence[Sequence[int]], status: str = "heuristic",
+             solve_s: float = 0.0) -> Schedule:
+    first, then = fleet.legs
+    makespans, help_time = [], 0
+    for k, route in enumerate(routes):
+        t, prev = 0, None
+        for j in route:
+            t += first[k][j] if prev is None else then[prev][j]
+            if j == fleet.help_job:
+                help_time = t
+            prev = j
+        makespans.append(t)
+    feasible = fleet.cap is None or max(makespans, default=0) <= fleet.cap
+    return Schedule(tuple(tuple(r) for r in routes), tuple(makespans), help_time,
+                    sum(makespans) + help_time, feasible, status, solve_s)
+
+
+def _route_cost(fleet: Fleet, k: int, route: Sequence[int]) -> float:
+    """Robot k's makespan + the help wait if it carries the help job, + cap penalty."""
+    first, then = fleet.legs
+    t, prev, wait = 0, None, 0
+    for j in route:
+        t += first[k][j] if prev is None else then[prev][j]
+        if j == fleet.help_job:
+            wait = t
+        prev = j
+    over = max(0, t - fleet.cap) if fleet.cap is not None else 0
+    return t + wait + OVER_CAP_PENALTY * over
+
+
+def _penalized(fleet: Fleet, routes) -> float:
+    return sum(_route_cost(fleet, k, r) for k, r in enumerate(routes))
+
+
+def greedy_insertion(fleet: Fleet, order: Sequence[int] | None = None) -> list[list[int]]:
+    """Insert jobs one by one where they raise the (penalized) cost least."""
+    routes: list[list[int]] = [[] for _ in fleet.starts]
+    for j in order if order is not None else range(len(fleet.jobs)):
+        best = None
+        for k in range(len(routes)):
+            for pos in range(len(routes[k]) + 1):
+                trial = [r[:] for r in routes]
+                trial[k].insert(pos, j)
+                c = _penalized(fleet, trial)
+                if best is None or c < best[0]:
+                    best = (c, k, pos)
+        routes[best[1]].insert(best[2], j)
+    return routes
+
+
+@dataclass(frozen=True)
+class ILSSettings:
+    """The iterated local search's knobs.
+
+    Args:
+        iterations: Perturb + local-search rounds.
+        perturb_moves: Random relocations per perturbation.
+        temperature: T in the acceptance probability exp(-(J' - J) / T) for worse J'.
+        seed: For the perturbations and the acceptance draws.
+    """
+
+    iterations: int = 100
+    perturb_moves: int = 2
+    temperature: float = 1.0
+    seed: int = 0
+
+
+def _moves(routes: list[list[int]], pinned: dict[int, int]):
+    """Every relocation (a job to any position of any robot) and swap of two jobs, as
+    ``{robot: its new route}`` for the one or two robots a move changes."""
+    where = [(k, p) for k, r in enumerate(routes) for p in range(len(r))]
+    for k, p in where:
+        j = routes[k][p]
+        rest = routes[k][:p] + routes[k][p + 1:]
+        for k2 in range(len(routes)):
+            if j in pinned and pinned[j] != k2:
+                continue
+            target = rest if k2 == k else routes[k2]
+            for p2 in range(len(target) + 1):
+                if k2 == k and p2 == p:
+                    continue
+                moved = target[:p2] + [j] + target[p2:]
+                yield {k: moved} if k2 == k else {k: rest, k2: moved}
+    for a in range(len(where)):
+        for b in range(a + 1, len(where)):
+            (ka, pa), (kb, pb) = where[a], where[b]
+            ja, jb = routes[ka][pa], routes[kb][pb]
+            if ka != kb and ((ja in pinned and pinned[ja] != kb)
+                             or (jb in pinned and pinned[jb] != ka)):
+                continue
+            if ka == kb:
+                r = routes[ka][:]
+                r[pa], r[pb] = jb, ja
+                yield {ka: r}
+            else:
+                ra, rb = routes[ka][:], routes[kb][:]
+                ra[pa], rb[pb] = jb, ja
+                yield {ka: ra, kb: rb}
+
+
+def local_search(fleet: Fleet, routes: list[list[int]],
+                 pinned: dict[int, int] | None = None) -> list[list[int]]:
+    """Best-improvement relocate/swap until no move lowers the cost.
+
+    A move changes one or two routes, so only those are costed again.
+    """
+    pinned = pinned or {}
+    routes = [r[:] for r in routes]
+    costs = [_route_cost(fleet, k, r) for k, r in enumerate(routes)]
+    while True:
+        best, best_gain = None, 0.0
+        for move in _moves(routes, pinned):
+            gain = sum(costs[k] - _route_cost(fleet, k, r) for k, r in move.items())
+            if gain > best_gain + 1e-9:
+                best, best_gain = move, gain
+        if best is None:
+            return routes
+        for k, r in best.items():
+            routes[k], costs[k] = r, _route_cost(fleet, k, r)
+
+
+def ils(fleet: Fleet, settings: ILSSettings = ILSSettings(),
+        pinned: dict[int, int] | None = None) -> Schedule:
+    """The paper's Oracle: GreedyInsertion, then iterated local search."""
+    import time
+
+    started = time.perf_counter()
+    pinned = pinned or {}
+    rng = random.Random(settings.seed)
+    routes = greedy_insertion(fleet)
+    for j, k in pinned.items():  # honour pins before searching
+        for r in routes:
+            if j in r:
+                r.remove(j)
+        routes[k].append(j)
+    current = local_search(fleet, routes, pinned)
+    cur_cost = _penalized(fleet, current)
+    best, best_cost = current, cur_cost
+    for _ in range(settings.iterations):
+        cand = _perturb(current, rng, settings.perturb_moves, pinned)
+        cand = local_search(fleet, cand, pinned)
+        c = _penalized(fleet, cand)
+        if c < cur_cost or rng.random() < math.exp(-(c - cur_cost) / settings.temperature):
+            current, cur_cost = cand, c
+        if c < best_cost:
+            best, best_cost = cand, c
+    return evaluate(fleet, best, "heuristic", time.perf_counter() - started)
+
+
+def _perturb(routes: list[list[int]], rng: random.Random, moves: int,
+             pinned: dict[int, int]) -> list[list[int]]:
+    new = [r[:] for r in routes]
+    for _ in range(moves):
+        jobs = [j for r in new for j in r if j not in pinned]
+        if not jobs:
+            break
+        j = rng.choice(jobs)
+        for r in new:
+            if j in r:
+                r.remove(j)
+        k = rng.randrange(len(new))
+        new[k].insert(rng.randint(0, len(new[k])), j)
+    return new
+
+
+def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int] | None = None,
+          time_limit_s: float = 60.0) -> Schedule:
+    """The optimum by MILP: job successions, completion times, MTZ order.
+
+    ``x[k,j]``: robot k does j first; ``y[i,j]``: j right after i. Every job has one
+    predecessor; each robot and job at most one successor. ``c[j] >= c[i] + leg`` on
+    chosen successions bounds completion times (the cap bounds them all); the sum of
+    chosen legs is the sum of makespans, and ``c[help]`` the requester's wait.
+    """
+    first, then = fleet.legs
+    n, robots = len(fleet.jobs), len(fleet.starts)
+    if n == 0:
+        return evaluate(fleet, [[] for _ in fleet.starts], "optimal")
+    pinned = pinned or {}
+    horizon = fleet.cap if fleet.cap is not None else sum(
+        max(max(first[k][j] for k in range(robots)), max(then[i][j] for i in range(n)))
+        for j in range(n))
+    big = horizon + max(max(map(max, first)), max(map(max, then))) + 1
+    m = LinearModel()
+    for j in range(n):
+        m.var(f"c[{j}]", min(first[k][j] for k in range(robots)), horizon)
+        m.var(f"u[{j}]", 1, n)
+        if pinned:
+            m.var(f"r[{j}]", 0, robots - 1)
+    for k in range(robots):
+        for j in range(n):
+            if j in pinned and pinned[j] != k:
+                continue
+            m.binary(f"x[{k},{j}]", cost=first[k][j])
+    for i in range(n):
+        for j in range(n):
+            if i != j:
+                m.binary(f"y[{i},{j}]", cost=then[i][j])
+    if fleet.help_job is not None:
+        m.add_cost(f"c[{fleet.help_job}]", 1)
+    has = m.index.__contains__
+    for j in range(n):
+        m.eq({**{f"x[{k},{j}]": 1 for k in range(robots) if has(f"x[{k},{j}]")},
+              **{f"y[{i},{j}]": 1 for i in range(n) if i != j}}, 1)
+        m.le({f"y[{j},{x}]": 1 for x in range(n) if x != j}, 1)
+    for k in range(robots):
+        row = {f"x[{k},{j}]": 1 for j in range(n) if has(f"x[{k},{j}]")}
+        if row:
+            m.le(row, 1)
+    for k in range(robots):
+        for j in range(n):
+            if has(x := f"x[{k},{j}]"):
+                m.ge({f"c[{j}]": 1, x: -big}, first[k][j] - big)
+                if pinned:
+                    m.le({f"r[{j}]": 1, x: robots}, k + robots)
+                    m.ge({f"r[{j}]": 1, x: -robots}, k - robots)
+    for i in range(n):
+        for j in range(n):
+            if i == j:
+                continue
+            y = f"y[{i},{j}]"
+            m.ge({f"c[{j}]": 1, f"c[{i}]": -1, y: -big}, then[i][j] - big)
+            m.ge({f"u[{j}]": 1, f"u[{i}]": -1, y: -n}, 1 - n)
+            if pinned:
+                m.le({f"r[{j}]": 1, f"r[{i}]": -1, y: robots}, robots)
+                m.ge({f"r[{j}]": 1, f"r[{i}]": -1, y: -robots}, -robots)
+    for j, k in pinned.items():
+        m.row({f"r[{j}]": 1}, k, k)
+    solution = (solver or make_solver()).solve(m, time_limit_s)
+    if not solution.has_solution:
+        return Schedule((), (), 0, 0, False, solution.status, solution.solve_s)
+    v = solution.values
+    routes = []
+    for k in range(robots):
+        route, prev = [], next((j for j in range(n) if v.get(f"x[{k},{j}]", 0) > 0.5), None)
+        while prev is not None:
+            route.append(prev)
+            prev = next((j for j in range(n) if j != prev and v[f"y[{prev},{j}]"] > 0.5), None)
+        routes.append(route)
+    schedule = evaluate(fleet, routes, solution.status, solution.solve_s)
+    return Schedule(schedule.routes, schedule.makespans, schedule.help_time, schedule.cost,
+                    schedule.feasible, solution.status, solution.solve_s,
+                    {"gap": solution.gap, **m.size})

@@ -1,0 +1,284 @@
+"""The decentralized help protocol: request, offers, accept/reject.
+
+A robot that cannot clear a conflict (a pallet in the aisle) broadcasts a request in
+NL. Each helper translates it to STL over its *own* propositions with the same
+translator and grammar as :mod:`ara.eval`, plans its jobs plus the help job, and
+offers ``tau_help`` (when the requester's wait ends) and ``tau_new`` (what helping
+adds to its own makespan). The requester accepts argmin(tau_help + tau_new), ties to
+the lowest id, and rejects the others.
+
+Messages are typed records that carry their NL text. NL comes from a template, or
+from an LLM under a grammar whose literal parts are the required fields (location,
+capabilities, the two numbers), so a generated message cannot lose them.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+from ara.coordination.events import UnsupportedSpec, Vocabulary
+from ara.coordination.milp import MILPSolver
+from ara.coordination.planner_dp import Job, plan_jobs
+from ara.coordination.planner_milp import plan_spec
+from ara.coordination.specs import (
+    jobs_spec,
+    jobs_vocabulary,
+    pick_ap,
+    place_ap,
+    pnp_spec,
+)
+from ara.coordination.world import Cell, GridWorld
+from ara.errors import AraError
+from ara.grammars import Formula, parse
+from ara.grammars import to_text as stl_text
+
+PLANNERS = ("dp", "milp")
+
+
+class ProtocolError(AraError, ValueError):
+    """A message that lacks a field the protocol needs."""
+
+
+# -- messages -------------------------------------------------------------------------
+@dataclass(frozen=True)
+class HelpRequest:
+    """Broadcast by a robot that needs help.
+
+    Attributes:
+        requester: Who asks.
+        site: The conflict cell (where the pallet is).
+        capabilities: What the requester can do itself.
+        text: The NL message.
+    """
+
+    requester: str
+    site: Cell
+    capabilities: tuple[str, ...]
+    text: str
+
+
+@dataclass(frozen=True)
+class Offer:
+    """A helper's answer to a request.
+
+    Attributes:
+        helper: The helper's index.
+        can_help: False when its spec could not be planned (see ``reason``).
+        tau_help: Steps until the help job is done.
+        tau_new: Steps helping adds to the helper's makespan.
+        stl: The help formula the helper planned for.
+        plan: The helper's new order of events (or job names).
+        solve_s: Planner time.
+        text: The NL message.
+    """
+
+    helper: int
+    can_help: bool
+    tau_help: int = 0
+    tau_new: int = 0
+    stl: str = ""
+    plan: tuple[str, ...] = ()
+    solve_s: float = 0.0
+    reason: str = ""
+    text: str = ""
+
+    @property
+    def bid(self) -> int:
+        return self.tau_help + self.tau_new
+
+
+@dataclass(frozen=True)
+class Decision:
+    helper: int
+    accepted: bool
+    text: str
+
+
+def request_text(site: Cell, capabilities: Sequence[str], what: str = "the aisle") -> str:
+    """The paper's request (App. B), with the requester's capabilities appended."""
+    r, c = site
+    return (f"A pallet is blocking {what} at location ({r}, {c}). Assistance is required to "
+            f"move the pallet. Pick up pallet at ({r},{c}) and drop it off at the closest "
+            f"free drop zone. I can only {', '.join(capabilities)}.")
+
+
+def offer_text(tau_help: int, tau_new: int) -> str:
+    return (f"I can help you in {tau_help} minutes, but it will add {tau_new} minutes to my "
+            "overall makespan.")
+
+
+def decline_text(reason: str) -> str:
+    return f"I cannot help: {reason}."
+
+
+_LOCATION = re.compile(r"at location \((\d+),\s*(\d+)\)")
+
+
+def request_site(text: str) -> Cell:
+    """The conflict cell a request names.
+
+    Raises:
+        ProtocolError: The text has no ``at location (r, c)``.
+    """
+    found = _LOCATION.search(text)
+    if not found:
+        raise ProtocolError(f"the request names no location ('at location (row, col)'): "
+                            f"{text!r}")
+    return int(found.group(1)), int(found.group(2))
+
+
+def generate_request(backend, site: Cell, capabilities: Sequence[str]) -> str:
+    """The request written by an LLM under a grammar: it chooses the words that say
+    what is blocked; every field the protocol needs is a literal of the grammar."""
+    from ara.grammars import Syntax
+    from ara.grammars.grammar_ir import Chars, Grammar, Lit, Opt, Ref, Rule
+    from ara.grammars.stl_grammar import BuiltGrammar
+
+    full = request_text(site, capabilities, "WHAT")
+    head, tail = full.split("WHAT")
+    word = Rule("word", ((Chars((("a", "z"),)),) + (Opt((Chars((("a", "z"),)),)),) * 9,))
+    words = Rule("words", ((Lit("the "), Ref("word")) + (Opt((Lit(" "), Ref("word"))),) * 3,))
+    grammar = Grammar((Rule("root", ((Lit(head), Ref("words"), Lit(tail)),)), words, word),
+                      "root")
+    built = BuiltGrammar(Syntax(aps=("p",)), grammar)
+    prompt = ("Write the help request of a robot that found a pallet in its way.\n"
+              f"Request: {request_text((3, 6), ('navigate',), 'the loading dock')}\n"
+              f"Request: {request_text((7, 2), ('navigate', 'scan shelves'), 'the aisle')}\n"
+              "Request:")
+    out = backend.complete(prompt + " ", built, int(grammar.max_length()) + 1, "\n")
+    text = out.text.strip()
+    if request_site(text) != tuple(site):
+        raise AssertionError(f"generated request lost its location: {text!r}")
+    return text
+
+
+# -- helpers --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Helper:
+    """A robot that may help: where it is, its jobs (in a plan it already has).
+
+    Attributes:
+        index: Its id (ties in bids go to the lowest).
+        start: Its cell.
+        jobs: Its own jobs.
+    """
+
+    index: int
+    start: Cell
+    jobs: tuple[Job, ...]
+
+
+def help_props(site: Cell, drop: Cell) -> tuple[str, str]:
+    """A helper's propositions for the help job: named after their cells, since that
+    is what the request says."""
+    return (pick_ap(f"r{site[0]}c{site[1]}"), place_ap(f"r{drop[0]}c{drop[1]}"))
+
+
+def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula:
+    """The help job's PNP spec, written from the request's fields (no LLM)."""
+    pick, place = help_props(site, drop)
+    spec = pnp_spec("h", others)
+    return _rename(spec, {pick_ap("h"): pick, place_ap("h"): place})
+
+
+def _rename(f: Formula, names: dict[str, str]) -> Formula:
+    from ara.grammars.ast import rename_atoms
+
+    return rename_atoms(f, names)
+
+
+@dataclass
+class HelpRound:
+    """Everything one request produced, for logs and demos."""
+
+    request: HelpRequest
+    offers: list[Offer] = field(default_factory=list)
+    decisions: list[Decision] = field(default_factory=list)
+    chosen: int | None = None
+
+    def to_dict(self) -> dict:
+        return {"request": asdict(self.request), "offers": [asdict(o) for o in self.offers],
+                "decisions": [asdict(d) for d in self.decisions], "chosen": self.chosen}
+
+
+def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: str = "dp",
+               objective: str = "paper", cap: int | None = 50, translator=None,
+               shots: Sequence = (), solver: MILPSolver | None = None) -> Offer:
+    """A helper reads the request, writes its STL, plans, and bids.
+
+    With a ``translator`` the help formula is the translator's (logged in the offer,
+    right or wrong, and planned as it says); without one it is the template spec.
+    The DP planner handles the template spec only.
+    """
+    if planner not in PLANNERS:
+        raise ProtocolError(f"planner must be one of {PLANNERS}, got {planner!r}")
+    site = request_site(request.text)
+    if not world.is_free(site):
+        return _decline(helper, f"{site} is not a free cell of my map")
+    drop = world.nearest_free_neighbour(site)
+    before = plan_jobs(world, helper.start, list(helper.jobs), "makespan")
+    if not before.feasible:
+        return _decline(helper, "my own jobs cannot be planned")
+    if planner == "dp" and translator is None:
+        jobs = [*helper.jobs, Job(site, drop, name="help")]
+        after = plan_jobs(world, helper.start, jobs, objective,
+                          help_index=len(jobs) - 1, cap=cap)
+        if not after.feasible:
+            return _decline(helper, "helping would exceed my makespan cap"
+                            if after.status == "over_cap" else "I cannot reach the site")
+        tau_help = after.completion[-1]
+        names = [j.name or f"j{i}" for i, j in enumerate(jobs)]
+        return _offer(helper, tau_help, after.makespan - before.makespan,
+                      stl_text(template_help_spec(site, drop, ())),
+                      tuple(names[i] for i in after.order), 0.0)
+    pick, place = help_props(site, drop)
+    own_vocab = jobs_vocabulary(world, list(helper.jobs))
+    vocab = own_vocab.merged(Vocabulary({pick: site, place: drop}))
+    if translator is None:
+        help_formula = template_help_spec(site, drop, sorted(own_vocab.events))
+    else:
+        result = translator.translate(request.text, (pick, place), shots, constrained=True)
+        if not result.valid:
+            return _decline(helper, f"could not translate the request ({result.error})")
+        help_formula = parse(result.stl)
+    try:
+        after = plan_spec(world, helper.start,
+                          {"own": jobs_spec(list(helper.jobs), (pick, place)),
+                           "help": help_formula},
+                          vocab, objective, cap, solver)
+    except UnsupportedSpec as err:
+        return _decline(helper, str(err), stl_text(help_formula))
+    if not after.feasible:
+        return _decline(helper, f"no plan satisfies my spec and the help request "
+                        f"({after.status})", stl_text(help_formula))
+    return _offer(helper, after.help_time or 0, after.makespan - before.makespan,
+                  stl_text(help_formula), after.order, after.solve_s)
+
+
+def _offer(helper: Helper, tau_help: int, tau_new: int, stl: str, plan, solve_s: float) -> Offer:
+    return Offer(helper.index, True, tau_help, tau_new, stl, tuple(plan), solve_s,
+                 text=offer_text(tau_help, tau_new))
+
+
+def _decline(helper: Helper, reason: str, stl: str = "") -> Offer:
+    return Offer(helper.index, False, stl=stl, reason=reason, text=decline_text(reason))
+
+
+def choose(offers: Sequence[Offer]) -> int | None:
+    """argmin(tau_help + tau_new) over the helpers who can help; ties to the lowest id."""
+    able = [o for o in offers if o.can_help]
+    return min(able, key=lambda o: (o.bid, o.helper)).helper if able else None
+
+
+def run_round(world: GridWorld, request: HelpRequest, helpers: Sequence[Helper],
+              **offer_options) -> HelpRound:
+    """Broadcast ``request``, collect offers, accept the best, reject the rest."""
+    round_ = HelpRound(request)
+    round_.offers = [make_offer(world, h, request, **offer_options) for h in helpers]
+    round_.chosen = choose(round_.offers)
+    round_.decisions = [Decision(o.helper, o.helper == round_.chosen,
+                                 "accept" if o.helper == round_.chosen else "reject")
+                        for o in round_.offers]
+    return round_

@@ -1,0 +1,79 @@
+"""The help protocol: messages carry their fields, bids pick the helper."""
+
+import pytest
+
+from ara.coordination.planner_dp import Job
+from ara.coordination.protocol import (
+    Helper,
+    HelpRequest,
+    Offer,
+    ProtocolError,
+    choose,
+    make_offer,
+    request_site,
+    request_text,
+    run_round,
+)
+from ara.coordination.world import GridWorld
+
+WORLD = GridWorld.paper()
+CAPS = ("navigate", "report conflicts")
+
+
+def request(site):
+    return HelpRequest("requester", site, CAPS, request_text(site, CAPS))
+
+
+def test_request_text_states_location_and_capabilities():
+    text = request_text((1, 4), CAPS)
+    assert text.startswith("A pallet is blocking the aisle at location (1, 4).")
+    assert "drop it off at the closest free drop zone" in text
+    assert "I can only navigate, report conflicts." in text
+    assert request_site(text) == (1, 4)
+    with pytest.raises(ProtocolError, match="names no location"):
+        request_site("Please help me somewhere.")
+
+
+def test_choose_takes_the_least_bid_and_the_lowest_id_on_ties():
+    offers = [Offer(0, True, 5, 9), Offer(1, True, 9, 4), Offer(2, False), Offer(3, True, 1, 12)]
+    assert choose(offers) == 1  # bids 14, 13, -, 13: the tie goes to the lower id
+    assert choose([Offer(0, True, 1, 1), Offer(1, False)]) == 0
+    assert choose([Offer(0, False)]) is None
+
+
+def test_round_accepts_one_rejects_the_rest():
+    helpers = [Helper(0, (0, 0), (Job((0, 2), (7, 2)),)), Helper(1, (3, 6), ()),
+               Helper(2, (7, 7), (Job((7, 6), (0, 6)), Job((0, 7), (7, 7))))]
+    rnd = run_round(WORLD, request((3, 4)), helpers)
+    assert rnd.chosen == 1  # idle and two steps away
+    assert [d.text for d in rnd.decisions] == ["reject", "accept", "reject"]
+    offer = rnd.offers[1]
+    assert offer.text == (f"I can help you in {offer.tau_help} minutes, but it will add "
+                          f"{offer.tau_new} minutes to my overall makespan.")
+    assert offer.tau_new == offer.tau_help  # an idle helper's makespan is the help job
+
+
+def test_a_helper_over_its_cap_declines_with_a_reason():
+    busy = Helper(0, (0, 0), (Job((7, 7), (0, 0)), Job((7, 7), (0, 0))))
+    offer = make_offer(WORLD, busy, request((7, 0)), cap=30)
+    assert not offer.can_help and "cap" in offer.reason and offer.text.startswith("I cannot")
+    blocked = make_offer(WORLD, busy, request((1, 1)))  # an obstacle cell
+    assert not blocked.can_help and "not a free cell" in blocked.reason
+
+
+@pytest.mark.llm
+def test_round_trip_with_the_embedded_llm(llama_backend):
+    """The embedded model writes the request under a grammar that keeps its fields,
+    and each helper plans whatever formula the same translator makes of it."""
+    from ara.coordination.protocol import generate_request
+    from ara.eval.translator import Translator
+    from ara.grammars import parse
+
+    text = generate_request(llama_backend, (3, 4), CAPS)
+    assert request_site(text) == (3, 4) and "I can only navigate, report conflicts." in text
+    req = HelpRequest("requester", (3, 4), CAPS, text)
+    helpers = [Helper(0, (0, 0), ()), Helper(1, (7, 7), (Job((7, 6), (0, 6)),))]
+    rnd = run_round(WORLD, req, helpers, planner="milp", translator=Translator(llama_backend))
+    for offer in rnd.offers:
+        assert offer.stl and parse(offer.stl)  # logged, and in the language
+        assert offer.can_help or offer.reason
