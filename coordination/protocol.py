@@ -176,6 +176,19 @@ def help_props(site: Cell, drop: Cell) -> tuple[str, str]:
     return (pick_ap(f"r{site[0]}c{site[1]}"), place_ap(f"r{drop[0]}c{drop[1]}"))
 
 
+def request_shots() -> tuple:
+    """Two worked requests (other sites) for the translator's prompt: the help job is
+    "pick up there, then drop off at the neighbour cell"."""
+    from ara.eval.prompt import Shot
+
+    shots = []
+    for site, drop in (((5, 2), (4, 2)), ((0, 6), (1, 6))):
+        pick, place = help_props(site, drop)
+        shots.append(Shot(request_text(site, ("navigate",)), (pick, place),
+                          f"F({pick} & F({place}))"))
+    return tuple(shots)
+
+
 def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula:
     """The help job's PNP spec, written from the request's fields (no LLM)."""
     pick, place = help_props(site, drop)
@@ -205,12 +218,13 @@ class HelpRound:
 
 def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: str = "dp",
                objective: str = "paper", cap: int | None = 50, translator=None,
-               shots: Sequence = (), solver: MILPSolver | None = None) -> Offer:
+               shots: Sequence | None = None, solver: MILPSolver | None = None) -> Offer:
     """A helper reads the request, writes its STL, plans, and bids.
 
     With a ``translator`` the help formula is the translator's (logged in the offer,
     right or wrong, and planned as it says); without one it is the template spec.
-    The DP planner handles the template spec only.
+    The DP planner handles the template spec only. ``shots`` default to
+    :func:`request_shots`.
     """
     if planner not in PLANNERS:
         raise ProtocolError(f"planner must be one of {PLANNERS}, got {planner!r}")
@@ -239,6 +253,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     if translator is None:
         help_formula = template_help_spec(site, drop, sorted(own_vocab.events))
     else:
+        shots = request_shots() if shots is None else shots
         result = translator.translate(request.text, (pick, place), shots, constrained=True)
         if not result.valid:
             return _decline(helper, f"could not translate the request ({result.error})")

@@ -11,19 +11,9 @@ from ara.training.recipe import LoRAFinetuneRecipe
 @pytest.fixture(scope="module")
 def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
     """A 2-layer, 32-wide Gemma 3 with random weights and the real 262k tokenizer."""
-    import torch
-    from transformers import AutoTokenizer, Gemma3ForCausalLM, Gemma3TextConfig
+    from ara.training.tiny import build_tiny_gemma
 
-    torch.manual_seed(0)
-    tokenizer = AutoTokenizer.from_pretrained(hf_model_dir)
-    config = Gemma3TextConfig(vocab_size=len(tokenizer), hidden_size=32, intermediate_size=64,
-                              num_hidden_layers=2, num_attention_heads=2, num_key_value_heads=1,
-                              head_dim=16, query_pre_attn_scalar=16, sliding_window=64,
-                              max_position_embeddings=1024)  # scalar = head_dim, as in Gemma 3
-    folder = tmp_path_factory.mktemp("tiny-gemma")
-    Gemma3ForCausalLM(config).save_pretrained(folder)
-    tokenizer.save_pretrained(folder)
-    return str(folder)
+    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
 
 
 def tiny_config(model_dir, out, **overrides):
@@ -136,3 +126,19 @@ def test_sharing_the_prompt_prefix_gives_the_same_loss_and_gradients(tiny_gemma_
     assert shared_loss == pytest.approx(plain_loss, rel=1e-5)
     for a, b in zip(plain_grads, shared_grads, strict=True):
         torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-6)
+
+
+def test_two_steps_reproduce_the_golden_losses(tiny_gemma_dir, tmp_path):
+    """The losses of scripts/golden_losses.py's run, within float tolerance: a change to
+    the data order, the prompt, the loss or the LoRA setup shows up here."""
+    from pathlib import Path
+
+    from ara.training.tiny import GOLDEN_RUN
+
+    golden = json.loads(Path(__file__).with_name("golden_losses.json").read_text())
+    assert golden["run"] == GOLDEN_RUN, "GOLDEN_RUN changed: rerun scripts/golden_losses.py"
+    config = TrainConfig.from_dict({**GOLDEN_RUN, "base_model": tiny_gemma_dir,
+                                    "out": str(tmp_path / "run")})
+    recipe = LoRAFinetuneRecipe(config)
+    recipe.setup()
+    assert recipe.train() == pytest.approx(golden["losses"], rel=1e-4)
