@@ -3,7 +3,8 @@
 Prepare the versioned splits; for a few test pairs show the formula, the grammar built
 from the pair's own propositions, and whether llama.cpp's grammar engine and Lark both
 admit it; Spot's verdicts between pairs; then translate a few test sentences with the
-embedded Gemma 3 270M under the grammar and judge each answer against the reference.
+embedded Gemma 3 270M under the grammar and judge each answer against the reference;
+last, the pallet help round, with the forklifts translating the request by the same model.
 """
 
 from __future__ import annotations
@@ -56,10 +57,21 @@ def demo_cmd(
     noisy = ("F(prop_1 | F(prop_2))", "F(prop_1) | F(prop_2)")
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
-    _translate_some(model, n, seed)
+    translator = _translate_some(model, n, seed)
+    _help_round(translator)
 
 
-def _translate_some(model: str, n: int, seed: int) -> None:
+def _help_round(translator) -> None:
+    """The paper's pallet scenario: each forklift translates the request and bids."""
+    from ara.coordination.demos import run_demo
+
+    typer.echo("\n== help request: forklifts translate the request with the same model, "
+               "plan with the event MILP, and bid")
+    run_demo("pallet", "runs/demos", translator,
+             lambda line: typer.echo(f"  {line}"))
+
+
+def _translate_some(model: str, n: int, seed: int):
     from ara.data import prepare
     from ara.eval.harness import judge
     from ara.eval.models import make_backend
@@ -77,6 +89,7 @@ def _translate_some(model: str, n: int, seed: int) -> None:
         typer.echo(f"  {r.nl}\n      model {result.stl}   ({result.ms:.0f} ms)\n"
                    f"      truth {r.stl}\n      equivalent={verdict['equivalent']} "
                    f"model=>truth={verdict['implies']}")
+    return translator
 
 
 def _lark_accepts(lark, grammar_text: str, text: str) -> bool:

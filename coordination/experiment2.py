@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ara.coordination.milp import make_solver
 from ara.coordination.oracle import Fleet, ILSSettings, exact, ils
 from ara.coordination.planner_dp import Job
 from ara.coordination.protocol import (
@@ -111,8 +112,9 @@ def closest_robot(trial: Trial) -> int:
 def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
     """All methods on one trial; one row per method."""
     world = PAPER_WORLD
+    solver = make_solver(config.solver)
     started = time.perf_counter()
-    before = exact(Fleet(world, trial.starts, trial.jobs, cap=config.cap))
+    before = exact(Fleet(world, trial.starts, trial.jobs, cap=config.cap), solver)
     before_s = time.perf_counter() - started
     if before.status != "optimal":
         raise RuntimeError(f"trial {trial.index}: the 12-job schedule failed ({before.status})")
@@ -128,7 +130,7 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
     request = HelpRequest("requester", trial.site, CAPABILITIES,
                           request_text(trial.site, CAPABILITIES))
     options = {"planner": config.planner, "objective": config.objective, "cap": config.cap,
-               "translator": translator}
+               "translator": translator, "solver": solver}
     t0 = time.perf_counter()
     offers = [make_offer(world, h, request, **options) for h in helpers]
     chosen = choose(offers)
@@ -148,9 +150,9 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
     fleet = Fleet(world, trial.starts, (*trial.jobs, trial.help_job), help_job=len(trial.jobs),
                   cap=config.cap)
     for method, solve in (
-        ("oracle_exact", lambda: exact(fleet)),
+        ("oracle_exact", lambda: exact(fleet, solver)),
         ("oracle_ils", lambda: ils(fleet, ILSSettings(config.ils_iterations, seed=trial.seed))),
-        ("b3", lambda: exact(fleet, pinned={len(trial.jobs): near})),
+        ("b3", lambda: exact(fleet, solver, pinned={len(trial.jobs): near})),
     ):
         t0 = time.perf_counter()
         s = solve()

@@ -8,13 +8,14 @@ the helper ``dwell`` steps at its pick cell. Objectives:
 .. math::
 
     \\text{makespan:}\\; M \\qquad
-    \\text{paper:}\\; D + T(\\varphi_{help}) + T(\\varphi_{new}) = 2M + t_{help} \\qquad
-    \\text{authors:}\\; T_{all} + D = 2M
+    \\text{paper:}\\; D + T(\\varphi_{help}) + T(\\varphi_{new}) = D + t_{help} + M \\qquad
+    \\text{authors:}\\; T_{all} + D = M + D
 
-(Choe et al., Sec. IV; D is the path length, which equals M here.) Each is a sum of
-per-leg weights: a leg of d steps weighs 2d, plus d while the help job is not yet done
-(paper objective). So the DP over (done jobs, last job) is exact. It is the test oracle
-for the MILP and the fast path for experiments. Among equally good orders it returns
+(Choe et al., Sec. IV; D is the path length: M less the dwell, since waiting never
+helps.) Each is a sum of per-leg weights: a leg of d steps, m of them moving, weighs
+d + m, plus d while the help job is not yet done (paper objective). So the DP over
+(done jobs, last job) is exact. It is the test oracle for the MILP and the fast path for
+experiments. Among equally good orders it returns
 one with the least makespan (both are sums over legs, so the pair orders exactly).
 """
 
@@ -91,12 +92,15 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
     legs = _leg_lengths(world, start, jobs)
     if legs is None:
         return Plan("unreachable")
-    from_start, between = legs
+    from_start, between, start_travel, travel = legs
     help_bit = 0 if help_index is None else 1 << help_index
 
-    def weight(mask: int, d: int) -> int:
-        extra = d if objective == "paper" and not mask & help_bit else 0
-        return (d if objective == "makespan" else 2 * d) + extra
+    def weight(mask: int, d: int, moved: int) -> int:
+        """A leg of d steps, ``moved`` of them travelling (the rest is dwell)."""
+        if objective == "makespan":
+            return d
+        waiting = d if objective == "paper" and not mask & help_bit else 0
+        return d + moved + waiting
 
     full = (1 << n) - 1
     inf = float("inf")
@@ -105,7 +109,7 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
     time = [[0] * n for _ in range(1 << n)]
     parent: list[list[int]] = [[-1] * n for _ in range(1 << n)]
     for j in range(n):
-        best[1 << j][j] = weight(0, from_start[j])
+        best[1 << j][j] = weight(0, from_start[j], start_travel[j])
         time[1 << j][j] = from_start[j]
     for mask in range(1, full + 1):
         for last in range(n):
@@ -117,7 +121,7 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
                     continue
                 d = between[last][j]
                 nxt = mask | (1 << j)
-                c = cost + weight(mask, d)
+                c = cost + weight(mask, d, travel[last][j])
                 # ties go to the shorter makespan, as in the MILP's objective
                 if c < best[nxt][j] or (c == best[nxt][j]
                                         and time[mask][last] + d < time[nxt][j]):
@@ -132,7 +136,8 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
 
 
 def _leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
-    """Steps from the start to finish each job, and from finishing one job to the next."""
+    """Steps from the start to finish each job, and from finishing one job to the next;
+    then the same without the dwell (the travelled part, D in the objectives)."""
     def dist(a: Cell, b: Cell) -> int | None:
         return world.distance(a, b) if world.is_free(a) and world.is_free(b) else None
 
@@ -141,10 +146,12 @@ def _leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
     first = [dist(start, job.pick) for job in jobs]
     if None in own or None in first or any(None in row for row in to_pick):
         return None
-    from_start = [first[j] + jobs[j].dwell + own[j] for j in range(len(jobs))]
-    between = [[to_pick[i][j] + jobs[j].dwell + own[j] for j in range(len(jobs))]
-               for i in range(len(jobs))]
-    return from_start, between
+    n = range(len(jobs))
+    start_travel = [first[j] + own[j] for j in n]
+    travel = [[to_pick[i][j] + own[j] for j in n] for i in n]
+    from_start = [start_travel[j] + jobs[j].dwell for j in n]
+    between = [[travel[i][j] + jobs[j].dwell for j in n] for i in n]
+    return from_start, between, start_travel, travel
 
 
 def _unwind(parent: list[list[int]], mask: int, last: int) -> list[int]:

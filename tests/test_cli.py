@@ -1,5 +1,6 @@
 """The `ara` command line: the contract later work and external checks rely on."""
 
+import importlib.util
 import json
 import os
 import subprocess
@@ -128,3 +129,10 @@ def test_coord_plan_and_its_errors(tmp_path):
     assert out.returncode == 2 and "bad.txt:2:2: unexpected 'x'" in out.stderr
     out = ara("coord", "exp2", "--out", str(tmp_path / "e"), "--llm", "default")
     assert out.returncode == 2 and "--planner milp" in out.stderr
+
+
+@pytest.mark.skipif(importlib.util.find_spec("gurobipy") is not None,
+                    reason="gurobipy is installed: the error path cannot be reached")
+def test_gurobi_without_gurobipy_is_a_clear_error(tmp_path):
+    out = ara("coord", "exp2", "--out", str(tmp_path / "e"), "--solver", "gurobi")
+    assert out.returncode == 2 and "needs gurobipy" in out.stderr

@@ -16,13 +16,14 @@ def brute_force(start, jobs, objective, help_index=None):
     """Least objective over all orders, straight from the definitions."""
     best = None
     for order in itertools.permutations(range(len(jobs))):
-        t, here, done = 0, start, {}
+        t, moved, here, done = 0, 0, start, {}
         for j in order:
-            t += WORLD.distance(here, jobs[j].pick) + jobs[j].dwell
-            t += WORLD.distance(jobs[j].pick, jobs[j].drop)
+            legs = WORLD.distance(here, jobs[j].pick) + WORLD.distance(jobs[j].pick, jobs[j].drop)
+            t, moved = t + legs + jobs[j].dwell, moved + legs
             here, done[j] = jobs[j].drop, t
-        value = {"makespan": t, "authors": 2 * t,
-                 "paper": 2 * t + (done[help_index] if help_index is not None else 0)}[objective]
+        value = {"makespan": t, "authors": t + moved,
+                 "paper": t + moved + (done[help_index] if help_index is not None else 0)}[
+            objective]
         best = value if best is None else min(best, value)
     return best
 

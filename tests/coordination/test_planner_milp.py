@@ -42,7 +42,7 @@ def test_milp_optimum_equals_the_dp_on_random_instances(objective):
     seen = set()
     for k in range(60):
         world = WALLED if k % 4 == 3 else PAPER
-        start, jobs = random_instance(rng, world, dwell=objective == "makespan")
+        start, jobs = random_instance(rng, world, dwell=True)
         cap = rng.choice([None, 12, 30])
         dp = plan_jobs(world, start, jobs, objective, cap=cap)
         mp = milp_plan(world, start, jobs, objective, cap)
@@ -109,3 +109,23 @@ def test_solver_reports_infeasible_models_and_unknown_solvers():
     assert HiGHSSolver().solve(m).status == "infeasible"
     with pytest.raises(ConfigError, match="unknown solver"):
         make_solver("cplex")
+
+
+def test_gurobi_backend_finds_the_same_optima():
+    """The optional backend, where gurobipy is installed (its pip license covers
+    these models: a few hundred variables)."""
+    pytest.importorskip("gurobipy", reason="gurobipy not installed (pip install gurobipy)")
+    from ara.coordination.experiment2 import make_trial
+    from ara.coordination.milp import GurobiSolver
+    from ara.coordination.oracle import Fleet, exact
+
+    trial = make_trial(0, 3000)
+    fleet = Fleet(PAPER, trial.starts, (*trial.jobs, trial.help_job), help_job=12)
+    assert exact(fleet, GurobiSolver()).cost == exact(fleet, HiGHSSolver()).cost
+    rng = random.Random(3)
+    for _ in range(5):
+        start, jobs = random_instance(rng, PAPER)
+        spec, vocab = {"own": jobs_spec(jobs)}, jobs_vocabulary(PAPER, jobs)
+        a = plan_spec(PAPER, start, spec, vocab, "authors", solver=GurobiSolver())
+        b = plan_spec(PAPER, start, spec, vocab, "authors", solver=HiGHSSolver())
+        assert (a.status, a.objective, a.makespan) == (b.status, b.objective, b.makespan)
