@@ -57,7 +57,8 @@ def ablation_cmd(
     split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
     form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
     variants: str = typer.Option("F,F+P,F+P+C", "--variants",
-                                 help="Comma list of variants: letters F, P, C joined by +."),
+                                 help="Comma list of variants: letters F, P, C joined by "
+                                      "+, or none (zero-shot, unconstrained)."),
     shots: str = typer.Option("5,20", "--shots", help="Comma list of few-shot counts."),
     reruns: int = typer.Option(3, "--reruns", help="Reruns, each with new examples."),
     limit: int = typer.Option(1000, "--limit", help="Test pairs to sample."),

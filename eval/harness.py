@@ -40,12 +40,14 @@ class Variant:
 
     @classmethod
     def parse(cls, name: str) -> Variant:
+        if name.strip().lower() == "none":  # zero-shot, no grammar: a fine-tune's own prompt
+            return cls("none", False, False, False)
         letters = name.strip().upper().split("+")
         unknown = [x for x in letters if x not in LETTERS]
         if unknown or len(set(letters)) != len(letters) or not name.strip():
             raise ConfigError(
                 f"variant {name!r}: use the letters F (few-shot), P (grammar in prompt), C "
-                "(constrained decoding) joined with '+', each once, e.g. F+P+C"
+                "(constrained decoding) joined with '+', each once, e.g. F+P+C; or none"
             )
         canonical = "+".join(x for x in "FPC" if x in letters)
         return cls(canonical, **{LETTERS[x]: x in letters for x in LETTERS})

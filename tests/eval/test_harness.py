@@ -13,13 +13,14 @@ from ara.eval.harness import AblationConfig, Variant, plan
         ("f+p", (True, True, False)),  # case does not matter
         ("C+P+F", (True, True, True)),  # order does not matter; printed as F+P+C
         ("C", (False, False, True)),  # constrained zero-shot
+        ("none", (False, False, False)),  # a fine-tuned model's own prompt
     ],
 )
 def test_variant_names_set_their_letters(name, flags):
     """Tests parsing variant names into their three switches."""
     v = Variant.parse(name)
     assert (v.few_shot, v.grammar_in_prompt, v.constrained) == flags
-    assert v.name == "+".join(x for x in "FPC" if x in name.upper())
+    assert v.name == ("+".join(x for x in "FPC" if x in name.upper()) or "none")
 
 
 @pytest.mark.parametrize("name", ["F+X", "F+F", "", "FP"])
