@@ -18,7 +18,12 @@ import typer
 def demo_cmd(
     n: int = typer.Option(4, "--n", help="How many test pairs to show."),
     seed: int = typer.Option(0, "--seed", help="Which pairs: the sampling seed."),
-    model: str = typer.Option("default", "--model", help="Translator model (see ara translate)."),
+    model: str = typer.Option("finetuned", "--model",
+                              help="Translator model (see ara translate): the shipped fine-tune "
+                                   "by default; `default` is the embedded base model."),
+    shots: int = typer.Option(None, "--shots",
+                              help="Worked examples in the prompt [default: 0 for the "
+                                   "fine-tune, which was trained without them; 5 otherwise]."),
 ) -> None:
     """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
     import lark
@@ -57,7 +62,9 @@ def demo_cmd(
     noisy = ("F(prop_1 | F(prop_2))", "F(prop_1) | F(prop_2)")
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
-    translator = _translate_some(model, n, seed)
+    if shots is None:
+        shots = 0 if model == "finetuned" else 5
+    translator = _translate_some(model, n, seed, shots)
     _help_round(translator)
 
 
@@ -71,7 +78,7 @@ def _help_round(translator) -> None:
              lambda line: typer.echo(f"  {line}"))
 
 
-def _translate_some(model: str, n: int, seed: int):
+def _translate_some(model: str, n: int, seed: int, k: int):
     from ara.data import prepare
     from ara.eval.harness import judge
     from ara.eval.models import make_backend
@@ -80,9 +87,9 @@ def _translate_some(model: str, n: int, seed: int):
 
     split = prepare("paper", 0)
     rng = random.Random(seed)
-    shots = sample_shots(split.records("train", "grounded"), 5, rng)
+    shots = sample_shots(split.records("train", "grounded"), k, rng) if k else []
     translator = Translator(make_backend(model))
-    typer.echo(f"\n== translate: {translator.backend.model_id}, 5 shots, grammar-constrained")
+    typer.echo(f"\n== translate: {translator.backend.model_id}, {k} shots, grammar-constrained")
     for r in rng.sample(split.records("test", "grounded"), n):
         result = translator.translate(r.nl, r.aps, shots)
         verdict = judge(r.stl, result.stl, timeout_s=10)

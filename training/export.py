@@ -108,10 +108,10 @@ def quantize(src: Path, dst: Path, quant: str) -> Path:
     return dst
 
 
-def lora_to_gguf(base_dir: str, adapter_dir: str, outfile: Path) -> Path:
-    """The adapter alone as a GGUF LoRA for llama.cpp."""
+def lora_to_gguf(base_dir: str, adapter_dir: str, outfile: Path, outtype: str = "f16") -> Path:
+    """The adapter alone as a GGUF LoRA for llama.cpp (f16 halves the file that ships)."""
     _run_converter("convert_lora_to_gguf.py", [adapter_dir, "--base", base_dir,
-                                               "--outfile", str(outfile), "--outtype", "f32"])
+                                               "--outfile", str(outfile), "--outtype", outtype])
     return outfile
 
 

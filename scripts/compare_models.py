@@ -1,0 +1,65 @@
+"""Base vs fine-tuned Gemma 3 270M, from the samples of the README's evaluation runs.
+
+    .venv/bin/python scripts/compare_models.py [--results docs/results]
+
+For each split, variant and shot count: validity and accuracy over *all* test pairs (an
+invalid or undecided answer counts as wrong), averaged over reruns. The runs are the
+ones `scripts/finetune_270m.sh eval` writes, plus the base model's 5-shot runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+from collections import defaultdict
+from pathlib import Path
+
+RUNS = {"base": ["base-270m-{split}", "base-270m-{split}-zeroshot"],
+        "fine-tuned": ["finetuned-270m-{split}"]}
+ORDER = ["none", "C", "F", "F+P", "F+P+C"]
+
+
+def cells(folder: Path) -> dict[tuple[str, int], dict]:
+    """(variant, shots) -> validity and accuracy in %, mean over reruns, and pairs."""
+    per = defaultdict(lambda: defaultdict(list))
+    for line in (folder / "samples.jsonl").read_text().splitlines():
+        s = json.loads(line)
+        per[(s["variant"], s["shots"])][s["rerun"]].append(s)
+    out = {}
+    for key, reruns in per.items():
+        val = [100 * statistics.fmean(x["valid"] for x in r) for r in reruns.values()]
+        acc = [100 * statistics.fmean(bool(x["equivalent"]) for x in r) for r in reruns.values()]
+        out[key] = {"validity": statistics.fmean(val), "accuracy": statistics.fmean(acc),
+                    "reruns": len(reruns), "pairs": len(next(iter(reruns.values())))}
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--results", type=Path, default=Path("docs/results"))
+    args = parser.parse_args()
+    print("| split | variant | shots | base validity | base accuracy | fine-tuned validity | "
+          "fine-tuned accuracy |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for split in ("paper", "disjoint"):
+        found = {}
+        for model, patterns in RUNS.items():
+            found[model] = {}
+            for pattern in patterns:
+                folder = args.results / pattern.format(split=split)
+                if (folder / "samples.jsonl").exists():
+                    found[model].update(cells(folder))
+        keys = sorted({k for m in found.values() for k in m if k[1] in (0, 5)},
+                      key=lambda k: (ORDER.index(k[0]) if k[0] in ORDER else 99, k[1]))
+        for key in keys:
+            row = [split, key[0], str(key[1])]
+            for model in ("base", "fine-tuned"):
+                c = found[model].get(key)
+                row += ([f"{c['validity']:.1f}", f"{c['accuracy']:.1f}"] if c else ["-", "-"])
+            print("| " + " | ".join(row) + " |")
+    print("\nPairs per cell: 200; base 5-shot cells average 3 reruns, all others 1.")
+
+
+if __name__ == "__main__":
+    main()
