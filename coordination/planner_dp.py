@@ -103,6 +103,12 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
         return d + moved + waiting
 
     full = (1 << n) - 1
+    if cap is not None:
+        capped = _plan_within_cap(n, from_start, between, start_travel, travel, weight, cap)
+        if capped is not None:
+            order, cost = capped
+            completion = _completion_times(order, from_start, between)
+            return Plan("optimal", tuple(order), tuple(completion), max(completion), cost)
     inf = float("inf")
     # best[mask][j]: least cost with the jobs of mask done, j last; time[...]: its makespan
     best = [[inf] * n for _ in range(1 << n)]
@@ -133,6 +139,43 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
     if cap is not None and makespan > cap:
         return Plan("over_cap", tuple(order), tuple(completion), makespan, int(best[full][last]))
     return Plan("optimal", tuple(order), tuple(completion), makespan, int(best[full][last]))
+
+
+def _plan_within_cap(n, from_start, between, start_travel, travel, weight, cap):
+    """The best order whose makespan is at most ``cap``, or None if there is none.
+
+    The plain DP keeps one (least-cost) time per state, but under the paper objective a
+    dearer partial order can finish sooner and be the only one within the cap. So
+    states here are (done jobs, last job, step), steps bounded by the cap.
+    """
+    states: dict[tuple[int, int], dict[int, tuple[int, tuple | None]]] = {}
+    for j in range(n):
+        if from_start[j] <= cap:
+            states.setdefault((1 << j, j), {})[from_start[j]] = (
+                weight(0, from_start[j], start_travel[j]), None)
+    for mask in range(1, 1 << n):
+        for last in range(n):
+            for t, (cost, _) in list(states.get((mask, last), {}).items()):
+                for j in range(n):
+                    if mask & (1 << j) or t + between[last][j] > cap:
+                        continue
+                    t2 = t + between[last][j]
+                    c2 = cost + weight(mask, between[last][j], travel[last][j])
+                    slot = states.setdefault((mask | (1 << j), j), {})
+                    if t2 not in slot or c2 < slot[t2][0]:
+                        slot[t2] = (c2, (mask, last, t))
+    full = (1 << n) - 1
+    finals = [(cost, t, last) for last in range(n)
+              for t, (cost, _) in states.get((full, last), {}).items()]
+    if not finals:
+        return None
+    cost, t, last = min(finals)
+    order, key = [], (full, last, t)
+    while key is not None:
+        mask, j, step = key
+        order.append(j)
+        key = states[(mask, j)][step][1]
+    return order[::-1], cost
 
 
 def _leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):

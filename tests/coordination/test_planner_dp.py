@@ -74,3 +74,35 @@ def test_paper_objective_needs_the_help_job():
     """Tests the message when the help job is not named."""
     with pytest.raises(ConfigError, match="give help_index"):
         plan_jobs(WORLD, (0, 0), [Job((1, 0), (2, 0))], "paper")
+
+
+def test_the_cap_constrains_the_search_not_just_the_answer():
+    """Under the paper objective the cheapest order can run past the cap while a dearer
+    one fits: the planner must find the dearer one (brute force over orders)."""
+    import itertools
+
+    rng = random.Random(99)
+    checked = 0
+    for _ in range(300):
+        jobs = random_jobs(rng, rng.randint(2, 5))
+        jobs = [Job(j.pick, j.drop) for j in jobs]
+        start = rng.choice(WORLD.free_cells)
+        help_index = rng.randrange(len(jobs))
+        free = plan_jobs(WORLD, start, jobs, "paper", help_index)
+        cap = free.makespan - 1
+        best = None
+        for order in itertools.permutations(range(len(jobs))):
+            t, here, done = 0, start, {}
+            for j in order:
+                t += WORLD.distance(here, jobs[j].pick) + WORLD.distance(jobs[j].pick, jobs[j].drop)
+                here, done[j] = jobs[j].drop, t
+            if t <= cap:
+                value = 2 * t + done[help_index]
+                best = value if best is None else min(best, value)
+        plan = plan_jobs(WORLD, start, jobs, "paper", help_index, cap=cap)
+        if best is None:
+            assert plan.status == "over_cap"
+        else:
+            checked += 1
+            assert plan.feasible and plan.makespan <= cap and plan.objective == best
+    assert checked > 0
