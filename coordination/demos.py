@@ -17,9 +17,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ara.coordination.events import UnsupportedSpec, Vocabulary
-from ara.coordination.planner_dp import Job
+from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
-from ara.coordination.protocol import Helper, HelpRequest, request_text, run_round
+from ara.coordination.protocol import Helper, HelpRequest, help_props, request_text, run_round
+from ara.coordination.specs import job_names, jobs_vocabulary, pick_ap, place_ap
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import ConfigError
 from ara.grammars import parse
@@ -85,22 +86,20 @@ def _pallet(world: GridWorld, translator, echo) -> dict:
     for d in rnd.decisions:
         echo(f"[requester -> forklift {d.helper}] {d.text}")
     drop = world.nearest_free_neighbour(site)
-    for h in helpers:
-        cells = {f"pick_{j.name}": j.pick for j in h.jobs} | \
-                {f"place_{j.name}": j.drop for j in h.jobs}
-        cells |= {f"pick_r{site[0]}c{site[1]}": site, f"place_r{drop[0]}c{drop[1]}": drop}
-        order = next(o.plan for o in rnd.offers if o.helper == h.index) \
-            if h.index == rnd.chosen else _own_order(h)
+    for h, offer in zip(helpers, rnd.offers, strict=True):  # offers come in helper order
+        cells = {**jobs_vocabulary(world, list(h.jobs)).events,
+                 **dict(zip(help_props(site, drop), (site, drop), strict=True))}
+        order = offer.plan if h.index == rnd.chosen else _own_order(world, h)
         paths[f"forklift {h.index}"] = _trace(world, h.start, [cells[e] for e in order])
     return {"title": f"pallet at {site}: forklift {rnd.chosen} helps", **rnd.to_dict(),
             "paths": paths, "marks": {"pallet": site}}
 
 
-def _own_order(h: Helper) -> list[str]:
-    from ara.coordination.planner_dp import plan_jobs
-
-    plan = plan_jobs(GridWorld.paper(), h.start, list(h.jobs))
-    return [e for i in plan.order for e in (f"pick_{h.jobs[i].name}", f"place_{h.jobs[i].name}")]
+def _own_order(world: GridWorld, h: Helper) -> list[str]:
+    """The events of a helper that keeps its own plan, in order."""
+    plan = plan_jobs(world, h.start, list(h.jobs))
+    names = job_names(h.jobs)
+    return [e for i in plan.order for e in (pick_ap(names[i]), place_ap(names[i]))]
 
 
 def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:

@@ -131,20 +131,23 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
                           request_text(trial.site, CAPABILITIES))
     options = {"planner": config.planner, "objective": config.objective, "cap": config.cap,
                "translator": translator, "solver": solver}
-    t0 = time.perf_counter()
-    offers = [make_offer(world, h, request, **options) for h in helpers]
+    offers, offer_s = [], []
+    for h in helpers:
+        t0 = time.perf_counter()
+        offers.append(make_offer(world, h, request, **options))
+        offer_s.append(time.perf_counter() - t0)
     chosen = choose(offers)
-    ours_s = time.perf_counter() - t0
     if chosen is None:
-        row("ours", None, None, ours_s, reason="no helper could help")
+        row("ours", None, None, sum(offer_s), reason="no helper could help")
     else:
         o = offers[chosen]
-        row("ours", o.bid, chosen, ours_s, tau_help=o.tau_help, tau_new=o.tau_new, stl=o.stl)
+        row("ours", o.bid, chosen, sum(offer_s), tau_help=o.tau_help, tau_new=o.tau_new,
+            stl=o.stl)
 
+    # B2 is the nearest forklift's own offer, whether or not it won the auction
     near = closest_robot(trial)
-    t0 = time.perf_counter()
-    o = make_offer(world, helpers[near], request, **options)
-    row("b2", o.bid if o.can_help else None, near, time.perf_counter() - t0,
+    o = offers[near]
+    row("b2", o.bid if o.can_help else None, near, offer_s[near],
         tau_help=o.tau_help, tau_new=o.tau_new, reason=o.reason)
 
     fleet = Fleet(world, trial.starts, (*trial.jobs, trial.help_job), help_job=len(trial.jobs),
@@ -155,10 +158,10 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
         ("b3", lambda: exact(fleet, solver, pinned={len(trial.jobs): near})),
     ):
         t0 = time.perf_counter()
-        s = solve()
-        ok = s.feasible and s.status in ("optimal", "feasible", "heuristic")
+        s = solve()  # a failed solve has no routes and is not feasible
         helper = next((k for k, r in enumerate(s.routes) if len(trial.jobs) in r), None)
-        row(method, s.cost - before.cost if ok else None, helper, time.perf_counter() - t0,
+        row(method, s.cost - before.cost if s.feasible else None, helper,
+            time.perf_counter() - t0,
             wait=s.help_time)
     for r in rows:
         r["before"] = before.cost
@@ -191,8 +194,9 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     tmp = store.with_suffix(".tmp")
     tmp.write_text("".join(json.dumps(r) + "\n" for r in done))
     tmp.replace(store)
+    finished = {r["trial"] for r in done}
     todo = [make_trial(i, config.seed + i, config.robots, config.jobs)
-            for i in range(config.trials) if i not in {r["trial"] for r in done}]
+            for i in range(config.trials) if i not in finished]
     from tqdm import tqdm
 
     bar = tqdm(total=config.trials, initial=config.trials - len(todo), desc="exp2",
@@ -225,7 +229,7 @@ class SharedTranslator:
 
     def translate(self, nl, aps, shots=(), grammar_in_prompt=False, constrained=True):
         key = (nl, tuple(aps), tuple(shots), grammar_in_prompt, constrained)
-        if key not in self._memo:
+        if key not in self._memo:  # one request at a time: keep only the latest
             self._memo = {key: self.translator.translate(nl, aps, shots, grammar_in_prompt,
                                                          constrained)}
         return self._memo[key]

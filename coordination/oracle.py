@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import math
 import random
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
 from ara.coordination.milp import LinearModel, MILPSolver, make_solver
-from ara.coordination.planner_dp import Job
+from ara.coordination.planner_dp import Job, leg_lengths
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import AraError
 
@@ -54,19 +55,15 @@ class Fleet:
     @cached_property
     def legs(self) -> tuple[list[list[int]], list[list[int]]]:
         """``first[k][j]``: robot k's steps to finish job j first; ``then[i][j]``:
-        steps to finish j right after i."""
-        w = self.world
-
-        def d(a: Cell, b: Cell) -> int:
-            dist = w.distance(a, b) if w.is_free(a) and w.is_free(b) else None
-            if dist is None:
-                raise FleetError(f"no path from {a} to {b}")
-            return dist
-
-        own = [j.dwell + d(j.pick, j.drop) for j in self.jobs]
-        first = [[d(s, j.pick) + own[x] for x, j in enumerate(self.jobs)] for s in self.starts]
-        then = [[d(a.drop, b.pick) + own[y] for y, b in enumerate(self.jobs)] for a in self.jobs]
-        return first, then
+        steps to finish j right after i (the per-robot planner's legs)."""
+        first = []
+        for k, start in enumerate(self.starts):
+            legs = leg_lengths(self.world, start, list(self.jobs))
+            if legs is None:
+                raise FleetError(f"no path from robot {k}'s start {start} to every job cell, "
+                                 "or from one job to another")
+            first.append(legs[0])
+        return first, legs[1]
 
 
 @dataclass(frozen=True)
@@ -82,30 +79,9 @@ class Schedule:
     solve_s: float = 0.0
     extra: dict = field(default_factory=dict)
 
-    @property
-    def total_makespan(self) -> int:
-        return sum(self.makespans)
 
-
-def evaluate(fleet: Fleet, routes: Sequence[Sequence[int]], status: str = "heuristic",
-             solve_s: float = 0.0) -> Schedule:
-    first, then = fleet.legs
-    makespans, help_time = [], 0
-    for k, route in enumerate(routes):
-        t, prev = 0, None
-        for j in route:
-            t += first[k][j] if prev is None else then[prev][j]
-            if j == fleet.help_job:
-                help_time = t
-            prev = j
-        makespans.append(t)
-    feasible = fleet.cap is None or max(makespans, default=0) <= fleet.cap
-    return Schedule(tuple(tuple(r) for r in routes), tuple(makespans), help_time,
-                    sum(makespans) + help_time, feasible, status, solve_s)
-
-
-def _route_cost(fleet: Fleet, k: int, route: Sequence[int]) -> float:
-    """Robot k's makespan + the help wait if it carries the help job, + cap penalty."""
+def _walk(fleet: Fleet, k: int, route: Sequence[int]) -> tuple[int, int]:
+    """Robot k's makespan on ``route``, and when it finishes the help job (0 if not on it)."""
     first, then = fleet.legs
     t, prev, wait = 0, None, 0
     for j in route:
@@ -113,6 +89,22 @@ def _route_cost(fleet: Fleet, k: int, route: Sequence[int]) -> float:
         if j == fleet.help_job:
             wait = t
         prev = j
+    return t, wait
+
+
+def evaluate(fleet: Fleet, routes: Sequence[Sequence[int]], status: str = "heuristic",
+             solve_s: float = 0.0) -> Schedule:
+    walks = [_walk(fleet, k, route) for k, route in enumerate(routes)]
+    makespans = [t for t, _ in walks]
+    help_time = sum(wait for _, wait in walks)  # at most one route holds the help job
+    feasible = fleet.cap is None or max(makespans, default=0) <= fleet.cap
+    return Schedule(tuple(tuple(r) for r in routes), tuple(makespans), help_time,
+                    sum(makespans) + help_time, feasible, status, solve_s)
+
+
+def _route_cost(fleet: Fleet, k: int, route: Sequence[int]) -> float:
+    """Robot k's makespan + the help wait if it carries the help job, + cap penalty."""
+    t, wait = _walk(fleet, k, route)
     over = max(0, t - fleet.cap) if fleet.cap is not None else 0
     return t + wait + OVER_CAP_PENALTY * over
 
@@ -124,16 +116,17 @@ def _penalized(fleet: Fleet, routes) -> float:
 def greedy_insertion(fleet: Fleet, order: Sequence[int] | None = None) -> list[list[int]]:
     """Insert jobs one by one where they raise the (penalized) cost least."""
     routes: list[list[int]] = [[] for _ in fleet.starts]
+    costs = [_route_cost(fleet, k, r) for k, r in enumerate(routes)]
     for j in order if order is not None else range(len(fleet.jobs)):
         best = None
-        for k in range(len(routes)):
+        for k in range(len(routes)):  # an insertion changes one route: cost only that one
             for pos in range(len(routes[k]) + 1):
-                trial = [r[:] for r in routes]
-                trial[k].insert(pos, j)
-                c = _penalized(fleet, trial)
-                if best is None or c < best[0]:
-                    best = (c, k, pos)
-        routes[best[1]].insert(best[2], j)
+                rise = _route_cost(fleet, k, routes[k][:pos] + [j] + routes[k][pos:]) - costs[k]
+                if best is None or rise < best[0]:
+                    best = (rise, k, pos)
+        _, k, pos = best
+        routes[k].insert(pos, j)
+        costs[k] = _route_cost(fleet, k, routes[k])
     return routes
 
 
@@ -211,8 +204,6 @@ def local_search(fleet: Fleet, routes: list[list[int]],
 def ils(fleet: Fleet, settings: ILSSettings = ILSSettings(),
         pinned: dict[int, int] | None = None) -> Schedule:
     """The paper's Oracle: GreedyInsertion, then iterated local search."""
-    import time
-
     started = time.perf_counter()
     pinned = pinned or {}
     rng = random.Random(settings.seed)

@@ -89,7 +89,7 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
     n = len(jobs)
     if n == 0:
         return Plan("optimal")
-    legs = _leg_lengths(world, start, jobs)
+    legs = leg_lengths(world, start, jobs)
     if legs is None:
         return Plan("unreachable")
     from_start, between, start_travel, travel = legs
@@ -178,7 +178,7 @@ def _plan_within_cap(n, from_start, between, start_travel, travel, weight, cap):
     return order[::-1], cost
 
 
-def _leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
+def leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
     """Steps from the start to finish each job, and from finishing one job to the next;
     then the same without the dwell (the travelled part, D in the objectives)."""
     def dist(a: Cell, b: Cell) -> int | None:

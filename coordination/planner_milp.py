@@ -184,17 +184,16 @@ def _build(program: EventProgram, weights: dict, objective: str, cap: int | None
         m.ge({f"u[{j}]": 1, f"u[{i}]": -1, x: -n}, 1 - n)
     for e in events:
         m.ge({"M": 1, f"t[{e}]": -1}, 0)
-    for w in program.windows:
-        if w.anchor == START:
-            m.row({f"t[{w.event}]": 1}, w.lo, w.hi if w.hi is not None else float("inf"))
-            continue
-        m.row({f"t[{w.event}]": 1, f"t[{w.anchor}]": -1}, w.lo,
+    for w in program.windows:  # the start is step 0, before everything
+        after_anchor = {} if w.anchor == START else {f"t[{w.anchor}]": -1}
+        m.row({f"t[{w.event}]": 1, **after_anchor}, w.lo,
               w.hi if w.hi is not None else float("inf"))
-        m.ge({f"u[{w.event}]": 1, f"u[{w.anchor}]": -1}, 1)
-    for anchor, until in _adjacent_pairs(program):
+        if w.anchor != START:
+            m.ge({f"u[{w.event}]": 1, f"u[{w.anchor}]": -1}, 1)
+    adjacent = set(_adjacent_pairs(program))
+    for anchor, until in adjacent:
         if (anchor, until) in weights:
             m.lower[m.index[f"x[{anchor},{until}]"]] = 1.0
-    adjacent = set(_adjacent_pairs(program))
     for k, ex in enumerate(program.exclusions):
         if ex.event not in events or ex.event in (ex.anchor, ex.until):
             continue  # an event never done is never in between

@@ -23,6 +23,7 @@ from ara.coordination.milp import MILPSolver
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
 from ara.coordination.specs import (
+    job_names,
     jobs_spec,
     jobs_vocabulary,
     pick_ap,
@@ -33,6 +34,7 @@ from ara.coordination.world import Cell, GridWorld
 from ara.errors import AraError
 from ara.grammars import Formula, parse
 from ara.grammars import to_text as stl_text
+from ara.grammars.ast import rename_atoms
 
 PLANNERS = ("dp", "milp")
 
@@ -192,14 +194,7 @@ def request_shots() -> tuple:
 def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula:
     """The help job's PNP spec, written from the request's fields (no LLM)."""
     pick, place = help_props(site, drop)
-    spec = pnp_spec("h", others)
-    return _rename(spec, {pick_ap("h"): pick, place_ap("h"): place})
-
-
-def _rename(f: Formula, names: dict[str, str]) -> Formula:
-    from ara.grammars.ast import rename_atoms
-
-    return rename_atoms(f, names)
+    return rename_atoms(pnp_spec("h", others), {pick_ap("h"): pick, place_ap("h"): place})
 
 
 @dataclass
@@ -243,7 +238,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
             return _decline(helper, "helping would exceed my makespan cap"
                             if after.status == "over_cap" else "I cannot reach the site")
         tau_help = after.completion[-1]
-        names = [j.name or f"j{i}" for i, j in enumerate(jobs)]
+        names = job_names(jobs)
         return _offer(helper, tau_help, after.makespan - before.makespan,
                       stl_text(template_help_spec(site, drop, ())),
                       tuple(names[i] for i in after.order), 0.0)
