@@ -177,16 +177,21 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     out.mkdir(parents=True, exist_ok=True)
     record = out / "run.json"
     settings = asdict(config)
+    # The translator first: its model hash belongs to the run's identity, so a resumed
+    # run cannot mix answers of two adapters.
+    translator = SharedTranslator(translator_factory()) if translator_factory else None
+    model = translator.backend.model_id if translator else None
     if record.exists():
-        old = json.loads(record.read_text())["config"]
-        if old != settings:
-            raise ConfigError(f"{out} holds a run with other settings ({old}); choose another "
-                              "--out or delete it")
+        old = json.loads(record.read_text())
+        if (old["config"], old.get("translator")) != (settings, model):
+            raise ConfigError(f"{out} holds a run with other settings ({old['config']}, "
+                              f"translator {old.get('translator')}); choose another --out "
+                              "or delete it")
     else:
         from ara.provenance import git_commit
 
-        record.write_text(json.dumps({"config": settings, "git_commit": git_commit()},
-                                     indent=2) + "\n")
+        record.write_text(json.dumps({"config": settings, "translator": model,
+                                      "git_commit": git_commit()}, indent=2) + "\n")
     store = out / "trials.jsonl"
     done = _load_rows(store)
     # Keep only whole trials: a line cut by an interruption, or a trial with some of its
@@ -202,7 +207,7 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     bar = tqdm(total=config.trials, initial=config.trials - len(todo), desc="exp2",
                unit="trial", disable=not progress)
     with store.open("a") as sink:
-        for rows in _map(todo, config, n_jobs, translator_factory):
+        for rows in _map(todo, config, n_jobs, translator):
             for r in rows:
                 sink.write(json.dumps(r) + "\n")
             sink.flush()
@@ -235,9 +240,8 @@ class SharedTranslator:
         return self._memo[key]
 
 
-def _map(trials: Sequence[Trial], config: Exp2Config, n_jobs: int, translator_factory):
-    if translator_factory is not None or n_jobs == 1:
-        translator = SharedTranslator(translator_factory()) if translator_factory else None
+def _map(trials: Sequence[Trial], config: Exp2Config, n_jobs: int, translator):
+    if translator is not None or n_jobs == 1:
         for t in trials:
             yield run_trial(t, config, translator)
         return

@@ -13,7 +13,8 @@ from ara.cli_support import emit, split_list, user_errors
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
 
-MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned, a .gguf path, hf:FOLDER, or an "
+MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lora:ADAPTER.gguf "
+              "(another LoRA on the same base), a .gguf path, hf:FOLDER, or an "
               "OpenAI-compatible http(s):// endpoint")
 
 
@@ -107,3 +108,43 @@ def score_cmd(
     with user_errors():
         results = write_report(folder)
     emit(results, as_json, tables_markdown)
+
+
+@eval_app.command("ceiling")
+def ceiling_cmd(
+    split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
+    form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
+    limit: int = typer.Option(0, "--limit",
+                              help="Measure the sample an ablation with this --limit and "
+                                   "--seed scores (0: the whole test side)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of that sample."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """The accuracy the data set's own labels allow: where one sentence carries
+    non-equivalent formulas, no translator can match them all."""
+    from ara.data import load_split
+    from ara.eval.ceiling import label_ceiling
+    from ara.eval.harness import AblationConfig, test_sample
+
+    with user_errors():
+        prepared = load_split(split)
+        if limit:
+            tests = test_sample(AblationConfig(split=split, form=form, limit=limit, seed=seed),
+                                prepared)
+        else:
+            tests = prepared.records("test", form)
+        result = label_ceiling(tests, prepared.records("train", form)).to_dict()
+    result.update(split=split, form=form, limit=limit or None, seed=seed)
+
+    def text(d: dict) -> str:
+        lines = [f"{d['split']} split, {d['form']} test records: {d['records']}",
+                 f"  best any translator can do:      {d['oracle']} "
+                 f"({100 * d['oracle_accuracy']:.2f}%)",
+                 f"  a flawless learner of the train: {d['train_majority']} "
+                 f"({100 * d['train_majority_accuracy']:.2f}%)",
+                 f"  inputs with conflicting labels:  {len(d['conflicts'])}"]
+        lines += [f"    {c['nl']!r}: test {c['test_labels']}, train's choice "
+                  f"{c['train_choice']}" for c in d["conflicts"]]
+        return "\n".join(lines)
+
+    emit(result, as_json, text)

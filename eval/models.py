@@ -2,6 +2,7 @@
 
 * ``default``: the embedded Gemma 3 270M Q4_K_M GGUF, through llama.cpp;
 * ``finetuned``: the fine-tuned adapter shipped in ``eval/models/`` on the embedded base;
+* ``lora:PATH``: a GGUF LoRA adapter (``ara export --lora-gguf``) on the embedded base;
 * a path ending in ``.gguf``: that file, through llama.cpp (exported fine-tunes, Gemma 3
   12B on a bigger machine);
 * ``hf:DIR_OR_ID``: a Hugging Face model through transformers (local folder, or a hub id
@@ -31,17 +32,18 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
         from ara.grammars.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
-    if model == "finetuned":
-        if not FINETUNED_LORA.is_file():
+    if model == "finetuned" or model.startswith("lora:"):
+        lora = FINETUNED_LORA if model == "finetuned" else Path(model[5:])
+        if not lora.is_file():
             raise BackendError(
-                f"no fine-tuned adapter at {FINETUNED_LORA}: this release ships none yet. "
-                "Use --model default, or a GGUF path from `ara export`"
+                f"no LoRA adapter at {lora}: `ara export --lora-gguf` writes one; "
+                "or use --model default, or a GGUF path from `ara export`"
             )
         from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
         from ara.grammars.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask,
-                               lora_path=str(FINETUNED_LORA))
+                               lora_path=str(lora))
     if model.startswith(("http://", "https://")):
         from ara.eval.backends.openai_http import OpenAIBackend
 
@@ -55,6 +57,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
 
         return LlamaCppBackend(model, n_ctx=n_ctx, mask=mask)
     raise BackendError(
-        f"--model {model!r} names no model: use default, finetuned, a path ending in .gguf, "
+        f"--model {model!r} names no model: use default, finetuned, lora:ADAPTER.gguf, a path "
+        "ending in .gguf, "
         "hf:FOLDER_OR_ID, or an http(s):// endpoint"
     )

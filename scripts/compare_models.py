@@ -2,9 +2,10 @@
 
     .venv/bin/python scripts/compare_models.py [--results docs/results]
 
-For each split, variant and shot count: validity and accuracy over *all* test pairs (an
+For each split, variant and shot count: accuracy and validity over *all* test pairs (an
 invalid or undecided answer counts as wrong), averaged over reruns. The runs are the
-ones `scripts/finetune_270m.sh eval` writes, plus the base model's 5-shot runs.
+ones `scripts/finetune_270m.sh eval disjoint` writes, the base model's 5-shot runs, and
+the first adapter's (480 steps, zero-shot prompts only) kept for comparison.
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ from collections import defaultdict
 from pathlib import Path
 
 RUNS = {"base": ["base-270m-{split}", "base-270m-{split}-zeroshot"],
-        "fine-tuned": ["finetuned-270m-{split}"]}
+        "fine-tuned, 0-shot training": ["finetuned-270m-zeroshot480-{split}"],
+        "fine-tuned, mixed-shot training": ["finetuned-270m-{split}"]}
 ORDER = ["none", "C", "F", "F+P", "F+P+C"]
 
 
@@ -39,9 +41,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, default=Path("docs/results"))
     args = parser.parse_args()
-    print("| split | variant | shots | base validity | base accuracy | fine-tuned validity | "
-          "fine-tuned accuracy |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+    print("| split | variant | shots | " + " | ".join(RUNS) + " |")
+    print("|---|---|---:|" + "---:|" * len(RUNS))
     for split in ("paper", "disjoint"):
         found = {}
         for model, patterns in RUNS.items():
@@ -54,11 +55,35 @@ def main() -> None:
                       key=lambda k: (ORDER.index(k[0]) if k[0] in ORDER else 99, k[1]))
         for key in keys:
             row = [split, key[0], str(key[1])]
-            for model in ("base", "fine-tuned"):
+            for model in RUNS:
                 c = found[model].get(key)
-                row += ([f"{c['validity']:.1f}", f"{c['accuracy']:.1f}"] if c else ["-", "-"])
+                row.append(f"{c['accuracy']:.1f} / {c['validity']:.1f}" if c else "-")
             print("| " + " | ".join(row) + " |")
-    print("\nPairs per cell: 200; base 5-shot cells average 3 reruns, all others 1.")
+    print("\nCells: accuracy / validity, in %. Pairs per cell: 200; base 5-shot cells "
+          "average 3 reruns, all others 1.")
+    print(ceilings(args.results))
+
+
+def ceilings(results: Path) -> str:
+    """What the labels allow on each split's sample (see `ara eval ceiling`)."""
+    from ara.data import load_split
+    from ara.eval.ceiling import label_ceiling
+    from ara.eval.harness import AblationConfig, test_sample
+
+    lines = []
+    for split in ("paper", "disjoint"):
+        run = results / f"base-270m-{split}-zeroshot" / "run.json"
+        if not run.exists():
+            continue
+        c = json.loads(run.read_text())["config"]
+        config = AblationConfig(split=split, form=c["form"], limit=c["limit"], seed=c["seed"])
+        prepared = load_split(split, c["data_seed"])
+        ceiling = label_ceiling(test_sample(config, prepared),
+                                prepared.records("train", c["form"]))
+        lines.append(f"{split}: a translator that follows the training labels can get at most "
+                     f"{ceiling.train_majority}/{ceiling.records} of these pairs right "
+                     f"({len(ceiling.conflicts)} inputs are labelled otherwise in training).")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

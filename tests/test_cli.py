@@ -91,11 +91,21 @@ def test_data_prepare_and_stats(tmp_path):
     assert out.returncode == 2 and "ara data prepare --split paper --seed 0" in out.stderr
 
 
+def test_eval_ceiling_on_an_ablation_sample(paper_split):
+    """Tests `ara eval ceiling` on the sample `ara eval ablation --limit 200` scores: a
+    translator that follows the training labels misses every conflict it lists."""
+    out = ara("eval", "ceiling", "--split", "paper", "--limit", "200", "--json")
+    result = json.loads(out.stdout)
+    assert result["records"] == 200 and result["oracle"] <= 200
+    assert result["train_majority"] == 200 - len(result["conflicts"]) < 200
+
+
 @pytest.mark.parametrize(
     "command",
     [[], ["stl"], ["stl", "parse"], ["stl", "equiv"], ["stl", "implies"], ["grammar"],
      ["data"], ["data", "prepare"], ["data", "stats"], ["data", "export"], ["demo"],
-     ["coord"], ["coord", "exp2"], ["coord", "demo"], ["coord", "plan"]],
+     ["coord"], ["coord", "exp2"], ["coord", "demo"], ["coord", "plan"],
+     ["eval", "ceiling"]],
 )
 def test_every_command_explains_itself(command):
     """Tests that --help works everywhere and says something."""

@@ -82,15 +82,24 @@ class DataSettings:
         seed: Seed the split was prepared with.
         forms: ``lifted``, ``grounded`` or both.
         limit: Use only the first N training records (``None``: all).
+        shots: Worked examples per prompt. Each batch draws one count from this list
+            and that many examples from the training records (none of its own rows),
+            which all its prompts share, as the prompts of one evaluation run do.
+            ``[0]`` trains zero-shot only; ``[0, 5, 20]`` prepares the adapter for the
+            few-shot variants as well.
     """
 
     split: str = "paper"
     seed: int = 0
     forms: tuple[str, ...] = ("lifted", "grounded")
     limit: int | None = None
+    shots: tuple[int, ...] = (0,)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "forms", tuple(self.forms))
+        object.__setattr__(self, "shots", tuple(self.shots))
+        if not self.shots or any(not isinstance(k, int) or k < 0 for k in self.shots):
+            raise ConfigError(f"data.shots must be a list of counts >= 0, got {self.shots}")
         bad = [f for f in self.forms if f not in ("lifted", "grounded")]
         if bad or not self.forms:
             raise ConfigError(f"data.forms must name lifted and/or grounded, got {self.forms}")
@@ -146,6 +155,7 @@ class TrainConfig:
     def to_dict(self) -> dict:
         data = asdict(self)
         data["data"]["forms"] = list(self.data.forms)
+        data["data"]["shots"] = list(self.data.shots)
         return data
 
     def to_json(self) -> str:

@@ -1,9 +1,10 @@
 """Training examples in the evaluation prompt's layout, with loss on the answer only.
 
-The prompt is :func:`ara.eval.prompt.build_prompt` with no worked examples, and the
-answer is what a model writes after ``"STL:"`` at evaluation time: a space, the
-canonical formula, the newline that ends it. The two are tokenized separately, as
-the prompt is at inference, so the model learns the token boundary it will meet.
+The prompt is :func:`ara.eval.prompt.build_prompt`, with the worked examples a batch
+drew (none for zero-shot training), and the answer is what a model writes after
+``"STL:"`` at evaluation time: a space, the canonical formula, the newline that ends
+it. The two are tokenized separately, as the prompt is at inference, so the model
+learns the token boundary it will meet.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from dataclasses import dataclass
 import torch
 
 from ara.data.normalize import Record
-from ara.eval.prompt import STOP, build_prompt
+from ara.eval.prompt import STOP, Shot, build_prompt
 from ara.eval.translator import ANSWER_PREFIX
 
 IGNORE = -100
@@ -33,11 +34,12 @@ class Example:
         return len(self.prompt_ids) + len(self.answer_ids)
 
 
-def encode(records: Sequence[Record], tokenizer) -> list[Example]:
-    """Tokenize records into examples."""
+def encode(records: Sequence[Record], tokenizer, shots: Sequence[Shot] = ()) -> list[Example]:
+    """Tokenize records into examples whose prompts show ``shots`` first."""
     examples = []
     for r in records:
-        prompt = tokenizer(build_prompt(r.nl, r.aps, ()), add_special_tokens=True)["input_ids"]
+        prompt = tokenizer(build_prompt(r.nl, r.aps, shots),
+                           add_special_tokens=True)["input_ids"]
         answer = tokenizer(f"{ANSWER_PREFIX}{r.stl}{STOP}", add_special_tokens=False)["input_ids"]
         examples.append(Example(tuple(prompt), tuple(answer)))
     return examples
@@ -57,16 +59,36 @@ def collate(batch: Sequence[Example], pad_id: int) -> dict[str, torch.Tensor]:
     return {"input_ids": ids, "attention_mask": mask, "labels": labels}
 
 
-def batches(examples: Sequence[Example], batch_size: int, seed: int, epoch: int,
-            skip: int = 0) -> Iterator[list[Example]]:
+def batches(items: Sequence, batch_size: int, seed: int, epoch: int,
+            skip: int = 0) -> Iterator[list]:
     """The batches of one epoch in a seeded order, after skipping ``skip`` of them.
 
     The order depends only on (seed, epoch), so a resumed run sees the same batches.
     """
-    order = list(range(len(examples)))
+    order = list(range(len(items)))
     random.Random(f"{seed}:{epoch}").shuffle(order)
     for start in range(skip * batch_size, len(order), batch_size):
-        yield [examples[i] for i in order[start: start + batch_size]]
+        yield [items[i] for i in order[start: start + batch_size]]
+
+
+def batch_shots(pool: Sequence[Record], batch: Sequence[Record], counts: Sequence[int],
+                rng: random.Random) -> list[Shot]:
+    """Worked examples for one batch: a count drawn from ``counts``, then that many
+    distinct records of ``pool`` that share no source row with the batch (a row's
+    lifted and grounded forms are one pair: showing either would give the answer away).
+    """
+    k = rng.choice(list(counts))
+    taken = {(r.source, r.row) for r in batch}
+    eligible = len({(r.source, r.row) for r in pool} - taken)
+    if k > eligible:
+        raise ValueError(f"asked for {k} shots; only {eligible} training pairs are eligible")
+    shots: list[Shot] = []
+    while len(shots) < k:
+        r = pool[rng.randrange(len(pool))]
+        if (r.source, r.row) not in taken:
+            taken.add((r.source, r.row))
+            shots.append(Shot.of(r))
+    return shots
 
 
 def shared_prefix_length(batch: dict[str, torch.Tensor]) -> int:

@@ -4,7 +4,8 @@
 
 Runs unchanged on one CPU, one GPU, or several through ``accelerate launch``. The run
 folder receives ``run.json`` (config, data and grammar versions, base-model hash, seed,
-git commit), ``train_log.jsonl`` (one line per step: loss, learning rate, tokens/s),
+git commit), ``train_log.jsonl`` (one line per step: loss, learning rate, worked
+examples shown, tokens/s, seconds),
 ``checkpoints/step_N`` (resumable), ``adapter/`` (the final LoRA) and
 ``heldout.json`` (validity and accuracy through the evaluation harness).
 """
@@ -12,6 +13,7 @@ git commit), ``train_log.jsonl`` (one line per step: loss, learning rate, tokens
 from __future__ import annotations
 
 import json
+import random
 import time
 from pathlib import Path
 
@@ -21,7 +23,7 @@ from tqdm import tqdm
 from ara import __version__
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
-from ara.training.dataset import answer_loss, batches, collate, encode
+from ara.training.dataset import answer_loss, batch_shots, batches, collate, encode
 
 
 class LoRAFinetuneRecipe:
@@ -54,8 +56,8 @@ class LoRAFinetuneRecipe:
         from transformers import AutoTokenizer
 
         self.tokenizer = AutoTokenizer.from_pretrained(self.model_dir, local_files_only=True)
-        self.train_examples, self.split = self._load_data()
-        per_epoch = -(-len(self.train_examples) // self.config.optim.batch_size)
+        self.train_records, self.split = self._load_data()
+        per_epoch = -(-len(self.train_records) // self.config.optim.batch_size)
         total = per_epoch * self.config.optim.epochs // self.config.optim.grad_accum
         self.total_steps = min(total, self.config.max_steps or total)
         self.steps_per_epoch = per_epoch // self.config.optim.grad_accum
@@ -87,7 +89,7 @@ class LoRAFinetuneRecipe:
         records = [r for f in self.config.data.forms for r in split.records("train", f)]
         if self.config.data.limit:
             records = records[: self.config.data.limit]
-        return encode(records, self.tokenizer), split
+        return records, split
 
     def _lora_model(self):
         from peft import LoraConfig, get_peft_model
@@ -116,7 +118,7 @@ class LoRAFinetuneRecipe:
         return {"config": self.config.to_dict(), "ara_version": __version__,
                 "git_commit": git_commit(), "grammar_version": GRAMMAR_VERSION,
                 "data": {"split": self.config.data.split, "version": self.split.version,
-                         "train_examples": len(self.train_examples)},
+                         "train_examples": len(self.train_records)},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
@@ -134,11 +136,13 @@ class LoRAFinetuneRecipe:
             while self.step < self.total_steps:
                 epoch, done = divmod(self.step, self.steps_per_epoch)
                 skip = done * cfg.optim.grad_accum
-                for micro in batches(self.train_examples, cfg.optim.batch_size, cfg.seed,
-                                     epoch, skip):
+                for index, micro in enumerate(batches(self.train_records, cfg.optim.batch_size,
+                                                      cfg.seed, epoch, skip), start=skip):
                     start = time.perf_counter()
+                    shots = self._shots(micro, epoch, index)
+                    examples = encode(micro, self.tokenizer, shots)
                     batch = {k: v.to(self.accelerator.device)
-                             for k, v in collate(micro, pad).items()}
+                             for k, v in collate(examples, pad).items()}
                     with self.accelerator.accumulate(self.model):
                         loss = answer_loss(self.model, batch)
                         self.accelerator.backward(loss)
@@ -150,11 +154,14 @@ class LoRAFinetuneRecipe:
                     self.step += 1
                     losses.append(loss.item())
                     tokens = int(batch["attention_mask"].sum())
-                    rate = tokens / (time.perf_counter() - start)
+                    seconds = time.perf_counter() - start
+                    rate = tokens / seconds
                     log.write(json.dumps({"step": self.step, "epoch": epoch,
                                           "loss": round(losses[-1], 5),
                                           "lr": self.scheduler.get_last_lr()[0],
-                                          "tokens_per_s": round(rate, 1)}) + "\n")
+                                          "shots": len(shots),
+                                          "tokens_per_s": round(rate, 1),
+                                          "seconds": round(seconds, 2)}) + "\n")
                     log.flush()
                     bar.set_postfix(loss=f"{losses[-1]:.3f}", tok_s=f"{rate:.0f}", refresh=False)
                     bar.update()
@@ -166,6 +173,12 @@ class LoRAFinetuneRecipe:
             bar.close()
             log.close()
         return losses
+
+    def _shots(self, micro, epoch: int, index: int):
+        """The batch's worked examples; seeded by its position, so a resumed run draws
+        the same ones."""
+        rng = random.Random(f"{self.config.seed}:{epoch}:{index}:shots")
+        return batch_shots(self.train_records, micro, self.config.data.shots, rng)
 
     # -- checkpoints ----------------------------------------------------------------
     def save_checkpoint(self) -> Path:
@@ -191,21 +204,34 @@ class LoRAFinetuneRecipe:
         return folder
 
     def heldout_check(self) -> dict:
-        """Validity and accuracy of the tuned model on test pairs, through the harness."""
+        """Validity and accuracy of the tuned model on test pairs, through the harness,
+        with each prompt layout it trained on (each count of worked examples).
+
+        The top-level ``validity`` and ``accuracy`` are those of the weakest layout.
+        """
         from ara.eval.backends.hf_backend import HFBackend
         from ara.eval.harness import judge
+        from ara.eval.prompt import sample_shots
         from ara.eval.translator import Translator
 
-        n = self.config.eval_pairs
+        n, form = self.config.eval_pairs, self.config.data.forms[0]
         model = self.accelerator.unwrap_model(self.model).eval()
         backend = HFBackend.from_objects(model, self.tokenizer, f"lora:{self.out.name}")
         translator = Translator(backend)
-        tests = self.split.records("test", self.config.data.forms[0])[:n]
-        results = [(r, translator.translate(r.nl, r.aps, (), constrained=True)) for r in tests]
-        verdicts = [judge(r.stl, res.stl, timeout_s=10)["equivalent"] for r, res in results]
-        report = {"pairs": len(results), "form": self.config.data.forms[0],
-                  "validity": sum(res.valid for _, res in results) / max(1, len(results)),
-                  "accuracy": sum(bool(v) for v in verdicts) / max(1, len(results))}
+        tests = self.split.records("test", form)[:n]
+        pool = self.split.records("train", form)
+        by_shots = {}
+        for k in sorted(set(self.config.data.shots)):
+            shots = sample_shots(pool, k, random.Random(f"{self.config.seed}:heldout:{k}"))
+            results = [(r, translator.translate(r.nl, r.aps, shots, constrained=True))
+                       for r in tqdm(tests, desc=f"held-out check, {k} shots", leave=False)]
+            verdicts = [judge(r.stl, res.stl, timeout_s=10)["equivalent"] for r, res in results]
+            by_shots[str(k)] = {
+                "validity": sum(res.valid for _, res in results) / max(1, len(results)),
+                "accuracy": sum(bool(v) for v in verdicts) / max(1, len(results))}
+        report = {"pairs": len(tests), "form": form, "by_shots": by_shots,
+                  "validity": min(v["validity"] for v in by_shots.values()),
+                  "accuracy": min(v["accuracy"] for v in by_shots.values())}
         self.out.joinpath("heldout.json").write_text(json.dumps(report, indent=2) + "\n")
         return report
 

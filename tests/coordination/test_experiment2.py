@@ -79,3 +79,18 @@ def test_parallel_trials_equal_serial_ones(tmp_path):
 def test_llm_requests_need_the_milp():
     with pytest.raises(ConfigError, match="--planner milp"):
         Exp2Config(llm="default", planner="dp")
+
+
+def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
+                                                                       llama_backend):
+    """Tests that run.json names the translator's model (file hashes), and that the
+    same folder refuses to continue with another model or none."""
+    from ara.eval.translator import Translator
+
+    out = tmp_path / "exp2-llm"
+    config = Exp2Config(trials=1, ils_iterations=5, llm="default", planner="milp")
+    run(config, out, translator_factory=lambda: Translator(llama_backend), progress=False)
+    record = json.loads((out / "run.json").read_text())
+    assert record["translator"] == llama_backend.model_id
+    with pytest.raises(ConfigError, match="translator gguf:"):
+        run(config, out, progress=False)

@@ -27,6 +27,8 @@ def test_shipped_configs_load_and_round_trip(path):
         ({"data": {"forms": ["lifted", "raw"]}}, "lifted and/or grounded"),
         ({"max_steps": 0}, "max_steps must be >= 1"),
         ({"lora": 3}, "lora must be a mapping"),
+        ({"data": {"shots": [0, -5]}}, "counts >= 0"),
+        ({"data": {"shots": []}}, "counts >= 0"),
     ],
 )
 def test_bad_configs_say_what_is_wrong(data, message):

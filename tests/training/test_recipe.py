@@ -50,16 +50,20 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
 
 
 def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path):
-    """Tests the saved adapter and the held-out check: even random weights give valid
-    formulas under the grammar, so validity is 1.0."""
-    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=1, eval_pairs=2)
+    """Tests the saved adapter and the held-out check, with prompts of 0 and 2 worked
+    examples: even random weights give valid formulas under the grammar."""
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2, eval_pairs=2,
+                         data={"forms": ["lifted"], "limit": 8, "shots": [0, 2]})
     recipe = LoRAFinetuneRecipe(config)
     recipe.setup()
     recipe.train()
+    log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]
+    assert {x["shots"] for x in log} <= {0, 2}
     adapter = recipe.save_adapter()
     assert (adapter / "adapter_config.json").is_file()
     report = recipe.heldout_check()
-    assert report["pairs"] == 2 and report["validity"] == 1.0
+    assert report["pairs"] == 2 and set(report["by_shots"]) == {"0", "2"}
+    assert report["validity"] == 1.0
 
 
 @pytest.mark.slow  # converts and quantizes a 262k-vocabulary model: about a minute
