@@ -23,7 +23,7 @@ def demo_cmd(
                                    "by default; `default` is the embedded base model."),
     shots: int = typer.Option(None, "--shots",
                               help="Worked examples in the prompt [default: 0 for the "
-                                   "fine-tune, which was trained without them; 5 otherwise]."),
+                                   "fine-tune, which needs none; 5 otherwise]."),
 ) -> None:
     """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
     import lark

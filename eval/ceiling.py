@@ -117,3 +117,23 @@ def label_ceiling(test: Sequence[Record], train: Sequence[Record],
         if best < len(labels) or right < len(labels):
             conflicts.append(Conflict(key[0], dict(Counter(labels)), choice))
     return Ceiling(len(test), oracle, majority, tuple(conflicts))
+
+
+def split_ceiling(prepared, form: str, limit: int = 0, seed: int = 0) -> Ceiling:
+    """The ceiling of a prepared split's test records, against its train records.
+
+    Args:
+        prepared: A :class:`~ara.data.store.PreparedSplit`.
+        form: ``lifted`` or ``grounded``.
+        limit: Measure only the sample an ablation with this ``limit`` and ``seed``
+            scores (0: the whole test side).
+        seed: Seed of that sample.
+    """
+    from ara.eval.harness import AblationConfig, test_sample
+
+    if limit:
+        config = AblationConfig(split=prepared.manifest["split"], form=form, limit=limit, seed=seed)
+        tests = test_sample(config, prepared)
+    else:
+        tests = prepared.records("test", form)
+    return label_ceiling(tests, prepared.records("train", form))

@@ -123,17 +123,10 @@ def ceiling_cmd(
     """The accuracy the data set's own labels allow: where one sentence carries
     non-equivalent formulas, no translator can match them all."""
     from ara.data import load_split
-    from ara.eval.ceiling import label_ceiling
-    from ara.eval.harness import AblationConfig, test_sample
+    from ara.eval.ceiling import split_ceiling
 
     with user_errors():
-        prepared = load_split(split)
-        if limit:
-            tests = test_sample(AblationConfig(split=split, form=form, limit=limit, seed=seed),
-                                prepared)
-        else:
-            tests = prepared.records("test", form)
-        result = label_ceiling(tests, prepared.records("train", form)).to_dict()
+        result = split_ceiling(load_split(split), form, limit, seed).to_dict()
     result.update(split=split, form=form, limit=limit or None, seed=seed)
 
     def text(d: dict) -> str:

@@ -67,8 +67,7 @@ def main() -> None:
 def ceilings(results: Path) -> str:
     """What the labels allow on each split's sample (see `ara eval ceiling`)."""
     from ara.data import load_split
-    from ara.eval.ceiling import label_ceiling
-    from ara.eval.harness import AblationConfig, test_sample
+    from ara.eval.ceiling import split_ceiling
 
     lines = []
     for split in ("paper", "disjoint"):
@@ -76,10 +75,8 @@ def ceilings(results: Path) -> str:
         if not run.exists():
             continue
         c = json.loads(run.read_text())["config"]
-        config = AblationConfig(split=split, form=c["form"], limit=c["limit"], seed=c["seed"])
-        prepared = load_split(split, c["data_seed"])
-        ceiling = label_ceiling(test_sample(config, prepared),
-                                prepared.records("train", c["form"]))
+        ceiling = split_ceiling(load_split(split, c["data_seed"]), c["form"], c["limit"],
+                                c["seed"])
         lines.append(f"{split}: a translator that follows the training labels can get at most "
                      f"{ceiling.train_majority}/{ceiling.records} of these pairs right "
                      f"({len(ceiling.conflicts)} inputs are labelled otherwise in training).")

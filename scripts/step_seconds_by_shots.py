@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import random
 import statistics
 from collections import defaultdict
 from pathlib import Path
 
 from ara.training.config import TrainConfig
+from ara.training.dataset import shot_rng
 
 
 def main() -> None:
@@ -34,8 +34,7 @@ def main() -> None:
         epoch, index = divmod(entry["step"] - 1, per_epoch)
         shots = entry.get("shots")
         if shots is None:
-            rng = random.Random(f"{config.seed}:{epoch}:{index}:shots")
-            shots = rng.choice(list(config.data.shots))
+            shots = shot_rng(config.seed, epoch, index).choice(list(config.data.shots))
         seconds[shots].append(entry["seconds"])
     print("| shots | steps | median s/step |\n|---:|---:|---:|")
     for k in sorted(seconds):

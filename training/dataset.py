@@ -71,6 +71,13 @@ def batches(items: Sequence, batch_size: int, seed: int, epoch: int,
         yield [items[i] for i in order[start: start + batch_size]]
 
 
+def shot_rng(seed: int, epoch: int, index: int) -> random.Random:
+    """The generator batch ``index`` of ``epoch`` draws its worked examples from; it
+    depends on nothing else, so a resumed run (or a later reader of the log) draws the
+    same ones."""
+    return random.Random(f"{seed}:{epoch}:{index}:shots")
+
+
 def batch_shots(pool: Sequence[Record], batch: Sequence[Record], counts: Sequence[int],
                 rng: random.Random) -> list[Shot]:
     """Worked examples for one batch: a count drawn from ``counts``, then that many
@@ -78,6 +85,8 @@ def batch_shots(pool: Sequence[Record], batch: Sequence[Record], counts: Sequenc
     lifted and grounded forms are one pair: showing either would give the answer away).
     """
     k = rng.choice(list(counts))
+    if k == 0:
+        return []
     taken = {(r.source, r.row) for r in batch}
     eligible = len({(r.source, r.row) for r in pool} - taken)
     if k > eligible:

@@ -23,7 +23,14 @@ from tqdm import tqdm
 from ara import __version__
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
-from ara.training.dataset import answer_loss, batch_shots, batches, collate, encode
+from ara.training.dataset import (
+    answer_loss,
+    batch_shots,
+    batches,
+    collate,
+    encode,
+    shot_rng,
+)
 
 
 class LoRAFinetuneRecipe:
@@ -175,10 +182,9 @@ class LoRAFinetuneRecipe:
         return losses
 
     def _shots(self, micro, epoch: int, index: int):
-        """The batch's worked examples; seeded by its position, so a resumed run draws
-        the same ones."""
-        rng = random.Random(f"{self.config.seed}:{epoch}:{index}:shots")
-        return batch_shots(self.train_records, micro, self.config.data.shots, rng)
+        """The batch's worked examples, drawn by its position (see ``shot_rng``)."""
+        return batch_shots(self.train_records, micro, self.config.data.shots,
+                           shot_rng(self.config.seed, epoch, index))
 
     # -- checkpoints ----------------------------------------------------------------
     def save_checkpoint(self) -> Path:
