@@ -18,11 +18,14 @@ test-all: setup  ## every test, slow ones included
 	$(BIN)/pytest $(PYTEST_ARGS)
 
 lint: setup
-	$(BIN)/ruff check ara grammars data eval training coordination tests bench
+	$(BIN)/ruff check ara grammars data eval training coordination tests bench scripts
 
 bench: setup  ## measurements, printed as tables; not part of the tests
 	$(BIN)/python bench/spot_bounds.py
 	$(BIN)/python bench/coord_planners.py
+	$(BIN)/python bench/translate_latency.py
+	$(BIN)/python bench/help_request_wordings.py
+	$(BIN)/python bench/self_consistency.py
 
 clean:
 	rm -rf data/prepared .pytest_cache

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import typer
 
 from ara import __version__
@@ -28,6 +30,17 @@ app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)
 app.command("train")(train_cmd)
 app.command("export")(export_cmd)
+
+
+def _note(message, category, filename, lineno, file=None, line=None) -> str:
+    """Warnings from our own code read as notes on the command line, not source lines."""
+    if category.__module__.startswith("ara."):
+        return f"note: {message}\n"
+    return _default_format(message, category, filename, lineno, line)
+
+
+_default_format = warnings.formatwarning
+warnings.formatwarning = _note
 
 
 def _version(value: bool) -> None:

@@ -2,9 +2,10 @@
 
 Prepare the versioned splits; for a few test pairs show the formula, the grammar built
 from the pair's own propositions, and whether llama.cpp's grammar engine and Lark both
-admit it; Spot's verdicts between pairs; then translate a few test sentences with the
-embedded Gemma 3 270M under the grammar and judge each answer against the reference;
-last, the pallet help round, with the forklifts translating the request by the same model.
+admit it; Spot's verdicts between pairs; then translate a few sentences of the
+hand-written suite (never trained on) with the embedded Gemma 3 270M and its shipped
+adapter under the grammar, judging each answer against the reference; last, the pallet
+help round, with the forklifts translating the request by the same model.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ def demo_cmd(
     from ara.grammars.spot_bridge import equivalent, implies
 
     typer.echo("== data: versioned splits")
-    for split in ("paper", "disjoint", "timed"):
+    for split in ("paper", "disjoint", "timed", "compositional", "handwritten"):
         p = prepare(split, 0)
         counts = ", ".join(f"{k} {sum(v.values())}" for k, v in p.manifest["counts"].items())
         typer.echo(f"  {p.folder.name}: {counts} records, "
@@ -63,7 +64,9 @@ def demo_cmd(
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
     if shots is None:
-        shots = 0 if model == "finetuned" else 5
+        from ara.eval.models import is_finetuned
+
+        shots = 0 if is_finetuned(model) else 5
     translator = _translate_some(model, n, seed, shots)
     _help_round(translator)
 
@@ -85,12 +88,13 @@ def _translate_some(model: str, n: int, seed: int, k: int):
     from ara.eval.prompt import sample_shots
     from ara.eval.translator import Translator
 
-    split = prepare("paper", 0)
     rng = random.Random(seed)
-    shots = sample_shots(split.records("train", "grounded"), k, rng) if k else []
+    pool = prepare("compositional", 0).records("train", "grounded")
+    shots = sample_shots(pool, k, rng) if k else []
     translator = Translator(make_backend(model))
-    typer.echo(f"\n== translate: {translator.backend.model_id}, {k} shots, grammar-constrained")
-    for r in rng.sample(split.records("test", "grounded"), n):
+    typer.echo(f"\n== translate: hand-written sentences no model trained on; "
+               f"{translator.backend.model_id}, {k} shots, grammar-constrained")
+    for r in rng.sample(prepare("handwritten", 0).records("test", "grounded"), n):
         result = translator.translate(r.nl, r.aps, shots)
         verdict = judge(r.stl, result.stl, timeout_s=10)
         typer.echo(f"  {r.nl}\n      model {result.stl}   ({result.ms:.0f} ms)\n"

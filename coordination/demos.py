@@ -19,11 +19,19 @@ from pathlib import Path
 from ara.coordination.events import UnsupportedSpec, Vocabulary
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
-from ara.coordination.protocol import Helper, HelpRequest, help_props, request_text, run_round
+from ara.coordination.protocol import (
+    Helper,
+    HelpRequest,
+    help_props,
+    request_text,
+    run_round,
+    template_help_spec,
+)
 from ara.coordination.specs import job_names, jobs_vocabulary, pick_ap, place_ap
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import ConfigError
 from ara.grammars import parse
+from ara.grammars.spot_bridge import equivalent
 
 DEMOS = ("pallet", "kitting", "tool")
 
@@ -80,12 +88,16 @@ def _pallet(world: GridWorld, translator, echo) -> dict:
     echo(f"[requester at {requester}] {request.text}")
     rnd = run_round(world, request, helpers, planner="milp", translator=translator)
     paths = {"requester": [requester]}
+    drop = world.nearest_free_neighbour(site)
+    template = template_help_spec(site, drop, ())
     for o in rnd.offers:
-        echo(f"[forklift {o.helper}] STL: {o.stl or '-'}")
+        same = bool(o.stl) and equivalent(parse(o.stl), template, timeout_s=10)
+        echo(f"[forklift {o.helper}] STL: {o.stl or '-'}"
+             + (f"  (pick-before-place template: {'equivalent' if same else 'differs'})"
+                if translator is not None else ""))
         echo(f"[forklift {o.helper}] {o.text}")
     for d in rnd.decisions:
         echo(f"[requester -> forklift {d.helper}] {d.text}")
-    drop = world.nearest_free_neighbour(site)
     for h, offer in zip(helpers, rnd.offers, strict=True):  # offers come in helper order
         cells = {**jobs_vocabulary(world, list(h.jobs)).events,
                  **dict(zip(help_props(site, drop), (site, drop), strict=True))}

@@ -32,7 +32,7 @@ from ara.coordination.specs import (
 )
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import AraError
-from ara.grammars import Formula, parse
+from ara.grammars import And, Formula, parse
 from ara.grammars import to_text as stl_text
 from ara.grammars.ast import rename_atoms
 
@@ -98,12 +98,46 @@ class Decision:
     text: str
 
 
-def request_text(site: Cell, capabilities: Sequence[str], what: str = "the aisle") -> str:
-    """The paper's request (App. B), with the requester's capabilities appended."""
-    r, c = site
-    return (f"A pallet is blocking {what} at location ({r}, {c}). Assistance is required to "
-            f"move the pallet. Pick up pallet at ({r},{c}) and drop it off at the closest "
-            f"free drop zone. I can only {', '.join(capabilities)}.")
+#: The request, in the paper's words (App. B) and ten rewordings; each names the site
+#: as "(row, col)", the pallet, the pick and the drop-off. ``{what}`` is what is blocked,
+#: ``{caps}`` the requester's own capabilities.
+REQUEST_WORDINGS = (
+    "A pallet is blocking {what} at location ({r}, {c}). Assistance is required to move the "
+    "pallet. Pick up pallet at ({r},{c}) and drop it off at the closest free drop zone. "
+    "I can only {caps}.",
+    "There is a pallet in {what} at ({r}, {c}). Could someone pick it up and then drop it at "
+    "the nearest free drop zone? I can only {caps}.",
+    "Help needed: pick up the pallet at location ({r}, {c}), then place it in the closest free "
+    "drop zone. It is blocking {what}. I am only able to {caps}.",
+    "I am stuck because a pallet blocks {what} at ({r}, {c}). Please first pick the pallet up, "
+    "and after that drop it off at the nearest free spot. My capabilities: {caps}.",
+    "Requesting assistance at location ({r}, {c}): a pallet is in {what}. Grab the pallet there "
+    "and put it down at the closest free drop zone afterwards. I can only {caps}.",
+    "Can a forklift help? A pallet at ({r}, {c}) is blocking {what}. It has to be picked up and "
+    "then dropped off at the nearest free drop zone. I can only {caps}.",
+    "Pallet blocking {what} at location ({r}, {c}). Task: pick it up, then drop it off at the "
+    "closest free drop zone. I can only {caps}.",
+    "{what} is blocked by a pallet at ({r}, {c}). I need someone to lift the pallet and then "
+    "set it down at the nearest free drop zone. I can only {caps}.",
+    "Please move the pallet at location ({r}, {c}) out of {what}: pick it up first, then drop "
+    "it at the closest free drop zone. I am only able to {caps}.",
+    "A pallet sits in {what} at ({r}, {c}) and I cannot pass. Collect the pallet and afterwards "
+    "deliver it to the nearest free drop zone. I can only {caps}.",
+    "Assistance required: there is a pallet at location ({r}, {c}) blocking {what}. Pick up the "
+    "pallet and, once it is picked up, drop it off at the closest free drop zone. I can only "
+    "{caps}.",
+)
+
+
+def request_text(site: Cell, capabilities: Sequence[str], what: str = "the aisle",
+                 wording: int = 0) -> str:
+    """The help request: the paper's wording (App. B) by default, or one of the
+    rewordings in :data:`REQUEST_WORDINGS`, with the requester's capabilities."""
+    if not 0 <= wording < len(REQUEST_WORDINGS):
+        raise ProtocolError(f"wording must be 0..{len(REQUEST_WORDINGS) - 1}, got {wording}")
+    text = REQUEST_WORDINGS[wording].format(what=what, r=site[0], c=site[1],
+                                            caps=", ".join(capabilities))
+    return text[0].upper() + text[1:]
 
 
 def offer_text(tau_help: int, tau_new: int) -> str:
@@ -115,19 +149,18 @@ def decline_text(reason: str) -> str:
     return f"I cannot help: {reason}."
 
 
-_LOCATION = re.compile(r"at location \((\d+),\s*(\d+)\)")
+_LOCATION = re.compile(r"\((\d+),\s*(\d+)\)")
 
 
 def request_site(text: str) -> Cell:
-    """The conflict cell a request names.
+    """The conflict cell a request names: its first ``(row, col)``.
 
     Raises:
-        ProtocolError: The text has no ``at location (r, c)``.
+        ProtocolError: The text has no ``(r, c)``.
     """
     found = _LOCATION.search(text)
     if not found:
-        raise ProtocolError(f"the request names no location ('at location (row, col)'): "
-                            f"{text!r}")
+        raise ProtocolError(f"the request names no location ('(row, col)'): {text!r}")
     return int(found.group(1)), int(found.group(2))
 
 
@@ -179,22 +212,27 @@ def help_props(site: Cell, drop: Cell) -> tuple[str, str]:
 
 
 def request_shots() -> tuple:
-    """Two worked requests (other sites) for the translator's prompt: the help job is
-    "pick up there, then drop off at the neighbour cell"."""
+    """Two worked requests (other sites, the paper's wording) for the translator's
+    prompt; each answer is the template's pick-before-place spec for its site."""
     from ara.eval.prompt import Shot
 
     shots = []
     for site, drop in (((5, 2), (4, 2)), ((0, 6), (1, 6))):
         pick, place = help_props(site, drop)
         shots.append(Shot(request_text(site, ("navigate",)), (pick, place),
-                          f"F({pick} & F({place}))"))
+                          stl_text(template_help_spec(site, drop, ()))))
     return tuple(shots)
 
 
 def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula:
-    """The help job's PNP spec, written from the request's fields (no LLM)."""
+    """The help job's PNP spec, written from the request's fields (no LLM).
+
+    Its conjunctions nest two at a time, ``(phi1 & phi2) & phi3``, so the decoding
+    grammar (at most two arguments per ``&``) can write it."""
     pick, place = help_props(site, drop)
-    return rename_atoms(pnp_spec("h", others), {pick_ap("h"): pick, place_ap("h"): place})
+    spec = rename_atoms(pnp_spec("h", others), {pick_ap("h"): pick, place_ap("h"): place})
+    first, second, third = spec.args
+    return And((And((first, second)), third))
 
 
 @dataclass

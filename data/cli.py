@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import emit, user_errors
-from ara.data.store import SPLITS, load_split, prepare, to_hf
+from ara.data.store import SPLITS, load_or_prepare, load_split, prepare, to_hf
 
 data_app = typer.Typer(help="Prepare, inspect and export the versioned NL2TL splits.",
                        no_args_is_help=True)
@@ -47,11 +47,12 @@ def stats_cmd(
     root: Path = ROOT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print JSON lines."),
 ) -> None:
-    """Record counts, rejected rows and train/test overlap of prepared splits."""
+    """Record counts, rejected rows and train/test overlap of the splits (each prepared
+    first if this machine lacks it: deterministic, versioned, seconds)."""
     rows = []
     for name in split:
         with user_errors():
-            m = load_split(name, seed, root).manifest
+            m = load_or_prepare(name, seed, root).manifest
         for form, o in m["overlap"].items():
             rows.append({
                 "split": name, "version": m["version"], "form": form,

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ara.data import manifest as mf
+from ara.data.handwritten import SUITE, suite_records
+from ara.data.mixture import compositional_split
 from ara.data.normalize import (
     NORMALIZER_VERSION,
     Record,
@@ -31,8 +33,10 @@ from ara.provenance import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
-SPLITS = ("paper", "disjoint", "timed")
+SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten")
 FORMS = ("lifted", "grounded")
+#: Splits fixed by their files, whatever the seed.
+UNSEEDED = ("timed", "handwritten")
 
 
 class DataVersionWarning(UserWarning):
@@ -84,6 +88,12 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
     """
     if split not in SPLITS:
         raise ConfigError(f"unknown split {split!r}. {did_you_mean(split, SPLITS)}")
+    if split == "compositional":
+        return compositional_split(RAW_DIR, seed)
+    if split == "handwritten":
+        # Test only: few-shot examples for it come from the compositional train side.
+        return ({"train": [], "test": suite_records()}, [],
+                {SUITE.name: sha256_file(SUITE)})
     if split == "timed":
         files = ["lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"]
         train, rej_train = normalize_timed(_read_jsonl(RAW_DIR / files[0]), "nl2tl_timed_train")
@@ -104,7 +114,10 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
 
     Args:
         split: ``paper`` (random 4,500/3,000 rows of navi), ``disjoint`` (no lifted
-            formula on both sides) or ``timed`` (NL2TL's own train/dev, seed unused).
+            formula on both sides), ``timed`` (NL2TL's own train/dev, seed unused) or
+            ``compositional`` (the training mixture; test: held-out synthetic shapes
+            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten`` (the
+            hand-written suite, test only; seed unused).
         seed: Shuffle seed.
         root: Parent folder; :func:`default_root` by default.
     """
@@ -118,7 +131,7 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
             (staging / f"{part}.jsonl").write_text(lines)
         manifest = mf.write(staging, {
             "split": split,
-            "seed": None if split == "timed" else seed,
+            "seed": None if split in UNSEEDED else seed,
             "normalizer_version": NORMALIZER_VERSION,
             "sources": sources,
             "counts": {p: {f: sum(r.form == f for r in parts[p]) for f in FORMS}
@@ -174,7 +187,7 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
     if split not in SPLITS:
         raise ConfigError(f"unknown split {split!r}. {did_you_mean(split, SPLITS)}")
     root = root or default_root()
-    key = _key(split, None if split == "timed" else seed)
+    key = _key(split, None if split in UNSEEDED else seed)
     version = version or registered_versions().get(key)
     if version is None:
         found = sorted(root.glob(f"{key}-*"))
@@ -189,10 +202,29 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
     if not folder.is_dir():
         raise DataVersionError(
             f"split {key} version {version} is not prepared in {root}; run "
-            f"`ara data prepare --split {split}" + ("" if split == "timed" else f" --seed {seed}")
+            f"`ara data prepare --split {split}" + ("" if split in UNSEEDED else f" --seed {seed}")
             + "`"
         )
     return PreparedSplit(folder, mf.verify(folder))
+
+
+class SplitPreparedNotice(UserWarning):
+    """A split was prepared on first use (deterministic, versioned, seconds)."""
+
+
+def load_or_prepare(split: str = "paper", seed: int = 0,
+                    root: Path | None = None) -> PreparedSplit:
+    """The registered version of a split, prepared first if this machine lacks it.
+
+    Preparing is deterministic and takes seconds, so commands that need a split do
+    not send the user to ``ara data prepare`` first; they say that they prepared it.
+    """
+    try:
+        return load_split(split, seed, root)
+    except DataVersionError:
+        warnings.warn(f"preparing the {split} split on first use (`ara data prepare "
+                      f"--split {split}`)", SplitPreparedNotice, stacklevel=2)
+        return prepare(split, seed, root)
 
 
 def to_hf(prepared: PreparedSplit, form: str | None = None):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ara.data import load_split
+from ara.data import load_or_prepare
 from ara.eval.backends.base import Backend
 from ara.eval.harness import AblationConfig, plan, run_job, run_metadata
 from ara.eval.report import Results, write_report
@@ -21,7 +21,7 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
     Interrupting (Ctrl-C, SIGTERM via the CLI) keeps every finished sample; the
     report is written from whatever is on disk, and ``resume=True`` continues.
     """
-    split = load_split(config.split, config.data_seed)
+    split = load_or_prepare(config.split, config.data_seed)
     meta = run_metadata(config, split, backend.model_id)
     translator = Translator(backend, config.translator)
     jobs = list(plan(config, split))

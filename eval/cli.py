@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import random
+import re
 import signal
 from pathlib import Path
 
 import typer
 
 from ara.cli_support import emit, split_list, user_errors
+from ara.errors import ConfigError
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -20,42 +22,76 @@ MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lo
 
 def translate_cmd(
     nl: str = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'."),
-    aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions."),
-    model: str = typer.Option("default", "--model", help=MODEL_HELP),
+    aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, each "
+                            "named in the sentence (go_to_kitchen: 'go to the kitchen')."),
+    model: str = typer.Option("finetuned", "--model", help=MODEL_HELP),
     no_constraint: bool = typer.Option(False, "--no-constraint",
                                        help="Decode freely instead of under the grammar."),
     grammar_in_prompt: bool = typer.Option(False, "--grammar-in-prompt",
                                            help="Show the grammar in the prompt."),
-    shots: int = typer.Option(5, "--shots", help="Worked examples from the paper split's train."),
+    shots: int | None = typer.Option(
+        None, "--shots", min=0, max=50,
+        help="Worked examples from the compositional train side; default 0 for the "
+             "fine-tuned adapters, 5 for other models."),
     seed: int = typer.Option(0, "--seed", help="Which worked examples."),
-    intervals: bool = typer.Option(False, "--intervals", help="Allow timed operators."),
+    intervals: bool = typer.Option(
+        True, "--intervals/--no-intervals",
+        help="Allow time bounds (F[a,b], G[a,b], U[a,b]); on by default, and an untimed "
+             "sentence still comes out untimed."),
+    max_bound: int = typer.Option(1000, "--max-bound", min=1,
+                                  help="Largest time bound the grammar admits."),
+    samples: int = typer.Option(
+        1, "--samples", min=1, max=32,
+        help="Self-consistency: K answers under the grammar (greedy + K-1 sampled), "
+             "grouped by Spot equivalence; the largest group wins. 1: greedy."),
+    temperature: float = typer.Option(0.7, "--temperature", min=0.01,
+                                      help="Sampling temperature for --samples."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Translate one instruction into STL over the given propositions."""
-    from ara.data import load_split, prepare
-    from ara.eval.models import make_backend
+    from ara.data import load_or_prepare
+    from ara.eval.models import is_finetuned, make_backend
     from ara.eval.prompt import sample_shots
-    from ara.eval.translator import Translator, TranslatorConfig
+    from ara.eval.translator import Translator, TranslatorConfig, check_request
 
     with user_errors():
-        try:
-            split = load_split("paper")
-        except ValueError:
-            split = prepare("paper")
-        examples = sample_shots(split.records("train", "grounded"), shots, random.Random(seed))
-        translator = Translator(make_backend(model), TranslatorConfig(intervals=intervals))
-        result = translator.translate(nl, split_list(aps), examples, grammar_in_prompt,
-                                      constrained=not no_constraint)
+        names = split_list(aps)
+        config = TranslatorConfig(intervals=intervals, max_bound=max_bound)
+        check_request(nl, names, config)
+        k = shots if shots is not None else (0 if is_finetuned(model) else 5)
+        form = "lifted" if all(re.fullmatch(r"prop_\d+", a) for a in names) else "grounded"
+        examples = (sample_shots(load_or_prepare("compositional").records("train", form), k,
+                                 random.Random(seed)) if k else [])
+        translator = Translator(make_backend(model), config)
+        vote = None
+        if samples > 1 and no_constraint:
+            raise ConfigError("--samples decodes under the grammar (every sample valid); "
+                              "drop --no-constraint")
+        if samples > 1:
+            from ara.eval.consistency import translate_consistent
+
+            vote = translate_consistent(translator, nl, names, examples, samples, temperature,
+                                        seed)
+            result = vote.result
+        else:
+            result = translator.translate(nl, names, examples, grammar_in_prompt,
+                                          constrained=not no_constraint)
     data = {"stl": result.stl, "valid": result.valid, "raw": result.raw,
-            "ms": round(result.ms, 1), "error": result.error, "model": translator.backend.model_id,
-            "constrained": result.constrained, "grammar": result.grammar}
+            "ms": round(vote.ms if vote else result.ms, 1), "error": result.error,
+            "model": translator.backend.model_id, "constrained": result.constrained,
+            "shots": k, "grammar": result.grammar}
+    if vote is not None:
+        data["samples"] = {"answers": list(vote.answers), "groups": [list(g) for g in vote.groups],
+                           "agreement": round(vote.agreement, 3)}
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
 
 
 @eval_app.command("ablation")
 def ablation_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder: samples.jsonl, results.json, ..."),
-    split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
+    split: str = typer.Option("paper", "--split",
+                              help="paper, disjoint, timed, compositional (held-out shapes "
+                                   "and phrasings) or handwritten (the hand-written suite)."),
     form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
     variants: str = typer.Option("F,F+P,F+P+C", "--variants",
                                  help="Comma list of variants: letters F, P, C joined by "

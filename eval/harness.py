@@ -58,7 +58,8 @@ class AblationConfig:
     """One ablation run.
 
     Args:
-        split: Prepared split (``paper``, ``disjoint``, ``timed``).
+        split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
+            ``handwritten``).
         form: ``lifted`` or ``grounded`` records.
         variants: Variant names, e.g. ``("F", "F+P", "F+P+C")``.
         shots: Few-shot counts for the F variants.
@@ -142,15 +143,29 @@ def test_sample(config: AblationConfig, split: PreparedSplit) -> list[Record]:
     return random.Random(config.seed).sample(records, config.limit)
 
 
+def shot_pool(config: AblationConfig, split: PreparedSplit) -> list[Record]:
+    """Where worked examples come from: the split's own train side, or for a test-only
+    split (``handwritten``) the compositional train side, which holds none of its
+    sentences."""
+    pool = split.records("train", config.form)
+    if pool or not any(v.few_shot for v in map(Variant.parse, config.variants)):
+        return pool
+    from ara.data import load_or_prepare
+
+    return load_or_prepare("compositional", config.data_seed).records("train", config.form)
+
+
 def plan(config: AblationConfig, split: PreparedSplit) -> Iterator[Job]:
     """Every generation of the run, grouped so that consecutive prompts share a prefix."""
     tests = test_sample(config, split)
-    pool = split.records("train", config.form)
+    pool = shot_pool(config, split)
     variants = [Variant.parse(v) for v in config.variants]
     for rerun in range(config.reruns):
         groups = [(k, [v for v in variants if v.few_shot]) for k in config.shots]
         groups.append((0, [v for v in variants if not v.few_shot]))
         for shots, group in groups:
+            if not group:
+                continue
             rng = random.Random(f"{config.seed}:{rerun}:{shots}")
             examples = tuple(sample_shots(pool, shots, rng)) if shots else ()
             for variant in group:
@@ -162,6 +177,8 @@ def judge(reference: str, output: str | None, timeout_s: float) -> dict:
     """Spot's verdicts on one output: equivalent to, and implying, the reference."""
     if output is None:
         return {"equivalent": None, "implies": None, "spot": "invalid"}
+    if output == reference:  # one canonical text is one tree: equal, without Spot
+        return {"equivalent": True, "implies": True, "spot": "same"}
     ref, out = parse(reference), parse(output)
     try:
         eq = equivalent(out, ref, timeout_s=timeout_s)

@@ -1,7 +1,9 @@
 """What ``--model`` can name, and the backend each becomes.
 
 * ``default``: the embedded Gemma 3 270M Q4_K_M GGUF, through llama.cpp;
-* ``finetuned``: the fine-tuned adapter shipped in ``eval/models/`` on the embedded base;
+* ``finetuned``: the shipped fine-tune (``eval/models/``, trained on the compositional
+  mixture) on the embedded base;
+* ``finetuned-paper``: the earlier adapter, trained on the paper split alone (Table I);
 * ``lora:PATH``: a GGUF LoRA adapter (``ara export --lora-gguf``) on the embedded base;
 * a path ending in ``.gguf``: that file, through llama.cpp (exported fine-tunes, Gemma 3
   12B on a bigger machine);
@@ -18,6 +20,14 @@ from ara.eval.backends.base import Backend, BackendError
 
 SHIPPED = Path(__file__).parent / "models"
 FINETUNED_LORA = SHIPPED / "gemma3-270m-nl2tl-lora.gguf"
+PAPER_LORA = SHIPPED / "gemma3-270m-nl2tl-paper-lora.gguf"
+#: ``--model`` names of the shipped adapters.
+SHIPPED_ADAPTERS = {"finetuned": FINETUNED_LORA, "finetuned-paper": PAPER_LORA}
+
+
+def is_finetuned(model: str) -> bool:
+    """Whether ``model`` names a fine-tuned adapter (these translate zero-shot)."""
+    return model in SHIPPED_ADAPTERS or model.startswith("lora:")
 
 
 def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
@@ -32,8 +42,8 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
         from ara.grammars.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
-    if model == "finetuned" or model.startswith("lora:"):
-        lora = FINETUNED_LORA if model == "finetuned" else Path(model[5:])
+    if model in SHIPPED_ADAPTERS or model.startswith("lora:"):
+        lora = SHIPPED_ADAPTERS[model] if model in SHIPPED_ADAPTERS else Path(model[5:])
         if not lora.is_file():
             raise BackendError(
                 f"no LoRA adapter at {lora}: `ara export --lora-gguf` writes one; "
@@ -57,7 +67,8 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
 
         return LlamaCppBackend(model, n_ctx=n_ctx, mask=mask)
     raise BackendError(
-        f"--model {model!r} names no model: use default, finetuned, lora:ADAPTER.gguf, a path "
+        f"--model {model!r} names no model: use default, finetuned, finetuned-paper, "
+        "lora:ADAPTER.gguf, a path "
         "ending in .gguf, "
         "hf:FOLDER_OR_ID, or an http(s):// endpoint"
     )

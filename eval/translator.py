@@ -9,12 +9,13 @@ complete formula, and :meth:`Syntax.check` is then asserted on it.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 
-from ara.errors import ConfigError, STLSyntaxError
-from ara.eval.backends.base import Backend
+from ara.errors import AraError, ConfigError, STLSyntaxError
+from ara.eval.backends.base import Backend, Sampling
 from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
 from ara.grammars import BuiltGrammar, Syntax, build_grammar, parse, to_text
 
@@ -31,14 +32,16 @@ class TranslatorConfig:
         max_args: Arguments of one & or | the constrained grammar allows. NL2TL needs 2,
             and 2 loses nothing (``(a & b) & c`` nests) while keeping the longest
             string, hence the worst-case token budget, short.
-        intervals: Whether formulas may carry time intervals.
+        intervals: Whether formulas may carry time intervals. On by default: a user
+            should not have to know whether a sentence has a time bound, and an
+            untimed sentence still comes out untimed.
         max_bound: Largest interval bound, with ``intervals``.
         max_tokens: Budget for unconstrained answers.
     """
 
     max_depth: int = 5
     max_args: int = 2
-    intervals: bool = False
+    intervals: bool = True
     max_bound: int = 1000
     max_tokens: int = 96
 
@@ -100,10 +103,53 @@ class TranslationResult:
         return data
 
 
+class RequestError(AraError, ValueError):
+    """An instruction that cannot be translated as asked (empty, about propositions it
+    never mentions, or with a bound the grammar cannot write)."""
+
+
+_STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
+
+
+def mentions(nl: str, ap: str) -> bool:
+    """Whether ``nl`` mentions proposition ``ap``: its name, or a word of it (3+ letters)."""
+    text = nl.lower()
+    if re.search(rf"\b{re.escape(ap.lower())}\b", text):
+        return True
+    words = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
+    return any(w in text for w in words)
+
+
+def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None:
+    """Refuse a request a user most likely got wrong, saying what to change.
+
+    Raises:
+        RequestError: If ``nl`` is blank, a proposition is never mentioned, or a
+            number in ``nl`` is above the grammar's largest bound.
+    """
+    if not nl.strip():
+        raise RequestError("the instruction is empty: pass the sentence to translate, e.g. "
+                           "'always avoid the door'")
+    unmentioned = [ap for ap in aps if not mentions(nl, ap)]
+    if unmentioned:
+        raise RequestError(
+            f"the instruction {nl!r} never mentions {', '.join(unmentioned)}: each proposition "
+            "in --aps must be named in the sentence (by its name or a word of it, e.g. "
+            "go_to_kitchen by 'kitchen'); drop the others from --aps")
+    numbers = [int(n) for n in re.findall(r"\d+", nl)]
+    if config.intervals and numbers and max(numbers) > config.max_bound:
+        raise RequestError(
+            f"the instruction mentions {max(numbers)}, above the grammar's largest time bound "
+            f"{config.max_bound}; pass --max-bound {max(numbers)} (Spot checks formulas up to "
+            "1000) or rescale the time unit")
+
+
 @lru_cache(maxsize=1024)
 def decoding_grammar(built: BuiltGrammar) -> BuiltGrammar:
-    """The grammar decoding runs under: the answer prefix, then a formula of ``built``."""
-    return BuiltGrammar(built.syntax, built.grammar.with_prefix(ANSWER_PREFIX))
+    """The grammar decoding runs under: the answer prefix, a formula of ``built``, and the
+    newline that ends an answer (see :meth:`Grammar.with_suffix`)."""
+    return BuiltGrammar(built.syntax,
+                        built.grammar.with_prefix(ANSWER_PREFIX).with_suffix(STOP))
 
 
 class Translator:
@@ -122,7 +168,8 @@ class Translator:
         return build_grammar(self.config.syntax(aps))
 
     def translate(self, nl: str, aps: Sequence[str], shots: Sequence[Shot] = (),
-                  grammar_in_prompt: bool = False, constrained: bool = True) -> TranslationResult:
+                  grammar_in_prompt: bool = False, constrained: bool = True,
+                  sampling: Sampling | None = None) -> TranslationResult:
         """Translate ``nl`` over the propositions ``aps``.
 
         Args:
@@ -131,6 +178,8 @@ class Translator:
             shots: Worked examples for the prompt (variant F).
             grammar_in_prompt: Show the grammar in the prompt (variant P).
             constrained: Decode under the grammar (variant C).
+            sampling: Draw the answer (seeded) instead of decoding greedily; see
+                :mod:`ara.eval.consistency`.
         """
         aps = tuple(aps)
         built = self.grammar(aps)
@@ -139,10 +188,13 @@ class Translator:
         if constrained:
             decoding = decoding_grammar(built)
             budget = int(decoding.grammar.max_length()) + 1
-            completion = self.backend.complete(prompt, decoding, budget, STOP)
+            completion = self.backend.complete(prompt, decoding, budget, STOP, sampling)
         else:
-            completion = self.backend.complete(prompt, None, self.config.max_tokens, STOP)
+            completion = self.backend.complete(prompt, None, self.config.max_tokens, STOP,
+                                               sampling)
         raw = completion.text
+        if constrained and raw.endswith(STOP):  # the grammar's own end, as STOP is freely
+            raw = raw[: -len(STOP)]
         stl, error = None, None
         try:
             stl = to_text(parse(raw))

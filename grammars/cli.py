@@ -34,6 +34,19 @@ def parse_cmd(
     emit({"stl": to_text(tree), "valid": True}, as_json, lambda v: v["stl"])
 
 
+@stl_app.command("explain")
+def explain_cmd(
+    formula: str = typer.Argument(..., help="A formula, e.g. 'G(door_open -> F[0,5](close))'."),
+    as_json: bool = JSON_OPT,
+) -> None:
+    """Read FORMULA back in plain English, deterministically (same realizer as the data)."""
+    from ara.grammars.english import explain
+
+    with user_errors():
+        tree = parse(formula)
+    emit({"stl": to_text(tree), "english": explain(tree)}, as_json, lambda v: v["english"])
+
+
 @stl_app.command("equiv")
 def equiv_cmd(
     a: str = typer.Argument(..., help="First formula."),

@@ -115,6 +115,20 @@ class Grammar:
         rules = (Rule(name, ((Lit(text), Ref(self.root)),)), *self.rules)
         return Grammar(rules, root=name)
 
+    def with_suffix(self, text: str) -> Grammar:
+        """The language ``w + text`` for each string ``w`` of this one.
+
+        Decoders end an answer with the newline a model writes after it in training.
+        A grammar that refused that end marker would leave the model to pick among the
+        operators that may continue a complete formula (``a -> ...``) and the end of
+        text, which it was never taught to emit there; the caller strips the suffix.
+        """
+        name = self.root + "_suffixed"
+        while name in self.by_name:
+            name += "_"
+        rules = (Rule(name, ((Ref(self.root), Lit(text)),)), *self.rules)
+        return Grammar(rules, root=name)
+
     @_memoized
     def to_gbnf(self) -> str:
         """The grammar in llama.cpp's GBNF; the start rule is named ``root``."""
@@ -278,7 +292,7 @@ def _gbnf_name(name: str) -> str:
 
 
 def _escape(text: str) -> str:
-    return text.replace("\\", "\\\\").replace('"', '\\"')
+    return text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
 
 
 def _quote(text: str) -> str:

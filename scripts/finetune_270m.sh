@@ -1,20 +1,24 @@
 #!/usr/bin/env bash
-# The shipped fine-tune, end to end, on a CPU: about 65 min of training on 2 cores,
-# then export and the README's evaluation runs (about 20 min); `disjoint` adds a
-# held-out adapter trained on the disjoint split (about 30 min).
+# The shipped fine-tune, end to end, on a CPU: about 90 min of training on 2 cores on the
+# compositional mixture, then export, ship and the evaluations (about 45 min).
 #
-#   scripts/finetune_270m.sh [STEP ...]   steps: train export ship eval disjoint full
+#   scripts/finetune_270m.sh [STEP ...]   steps: train export ship eval paper disjoint full
 #                                         (default: train export ship eval)
 #
-# `full` scores the shipped adapter zero-shot under the grammar on the whole paper test
-# side (2,989 lifted pairs, about 20 min).
+# train/export/ship: `--model finetuned` (training/configs/gemma3_270m_lora_cpu_compositional.yaml).
+# eval: the generalization runs of the new adapter, the paper-split adapter and the base
+#   model (scripts/eval_generalization.sh), the round trip, the help-request wordings.
+# paper: retrains the paper-split adapter (`--model finetuned-paper`, Table I) from its
+#   config and ships it; disjoint: an adapter trained on the disjoint split's train side;
+#   full: the shipped adapter zero-shot under the grammar on the whole paper test side.
 #
 # Each step can be rerun alone; training resumes from its newest checkpoint and the
 # evaluations from their finished samples.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=.venv/bin
-run=runs/train/gemma3-270m-lora
+run=runs/train/gemma3-270m-lora-compositional
+paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
 steps=${*:-train export ship eval}
 
@@ -28,45 +32,56 @@ ablation() {  # SPLIT MODEL OUT VARIANTS [LIMIT]
     --shots 5 --reruns 1 --limit "${5:-200}" --resume --no-progress
 }
 
-for step in $steps; do
-  case $step in
-  train)
-    train training/configs/gemma3_270m_lora_cpu.yaml "$run" ;;
-  export)
-    # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
-    $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
-  ship)
-    cp "$run/export/lora.gguf" eval/models/gemma3-270m-nl2tl-lora.gguf
-    $bin/python - "$run" <<'PY'
+ship() {  # RUN_FOLDER FILE_NAME PARITY_SPLIT
+  cp "$1/export/lora.gguf" "eval/models/$2"
+  $bin/python - "$1" "$2" "$3" <<'PY'
 import json, sys
 from pathlib import Path
+from ara.data import load_or_prepare
+from ara.eval.models import SHIPPED
+from ara.grammars.llama_check import default_model_path
 from ara.provenance import sha256_file
-run = Path(sys.argv[1])
-manifest = {"file": "gemma3-270m-nl2tl-lora.gguf",
-            "sha256": sha256_file(Path("eval/models/gemma3-270m-nl2tl-lora.gguf")),
+from ara.training.export import parity
+run, name, split = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+adapter = SHIPPED / name
+manifest = {"file": name, "sha256": sha256_file(adapter),
             "run": json.loads((run / "run.json").read_text()),
             "export": json.loads((run / "export" / "export.json").read_text()),
             "heldout": json.loads((run / "heldout.json").read_text())}
 # What a user runs: the adapter on the embedded Q4_K_M base, against the merged HF model
-from ara.data import load_split
-from ara.eval.models import FINETUNED_LORA
-from ara.grammars.llama_check import default_model_path
-from ara.training.export import parity
-split = load_split("paper", 0)
-records = split.records("test", "lifted")[:20] + split.records("test", "grounded")[:20]
+data = load_or_prepare(split, 0)
+records = data.records("test", "lifted")[:20] + data.records("test", "grounded")[:20]
 manifest["shipped_parity"] = {
     "what": "embedded Q4_K_M GGUF + this adapter (llama.cpp) vs the merged HF model "
-            "(transformers, fp32), greedy, zero-shot, unconstrained; 20 lifted + 20 "
-            "grounded paper test pairs",
-    **parity(Path(default_model_path()), run / "export" / "merged-hf", records,
-             lora=FINETUNED_LORA)}
-Path("eval/models/gemma3-270m-nl2tl-lora.json").write_text(json.dumps(manifest, indent=2) + "\n")
+            f"(transformers, fp32), greedy, zero-shot, unconstrained; 20 lifted + 20 "
+            f"grounded {split} test pairs",
+    **parity(Path(default_model_path()), run / "export" / "merged-hf", records, lora=adapter)}
+adapter.with_suffix(".json").write_text(json.dumps(manifest, indent=2) + "\n")
 PY
-    ;;
+}
+
+for step in $steps; do
+  case $step in
+  train)
+    train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$run" ;;
+  export)
+    # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
+    $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
+  ship)
+    ship "$run" gemma3-270m-nl2tl-lora.gguf compositional ;;
   eval)
-    ablation paper finetuned docs/results/finetuned-270m-paper none,C,F,F+P,F+P+C
-    ablation paper default docs/results/base-270m-paper-zeroshot none,C
-    $bin/ara eval ceiling --split paper --limit 200 ;;
+    scripts/eval_generalization.sh finetuned compositional-adapter-270m
+    VARIANTS=C,F+C scripts/eval_generalization.sh finetuned-paper paper-adapter-270m \
+      handwritten compositional timed
+    VARIANTS=C,F+C scripts/eval_generalization.sh default base-270m \
+      handwritten compositional timed
+    $bin/python scripts/generalization_table.py
+    $bin/python scripts/round_trip.py
+    $bin/python bench/help_request_wordings.py ;;
+  paper)
+    train training/configs/gemma3_270m_lora_cpu.yaml "$paper_run"
+    $bin/ara export --run "$paper_run" --quant f16 --lora-gguf --parity 20
+    ship "$paper_run" gemma3-270m-nl2tl-paper-lora.gguf paper ;;
   disjoint)
     # Trained on the disjoint split's own train side: its test pairs are held out.
     train training/configs/gemma3_270m_lora_cpu_disjoint.yaml "$disjoint_run"
@@ -76,8 +91,8 @@ PY
     ablation disjoint default docs/results/base-270m-disjoint-zeroshot none,C
     $bin/ara eval ceiling --split disjoint --limit 200 ;;
   full)
-    ablation paper finetuned docs/results/finetuned-270m-paper-full C 3000
+    ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train export ship eval disjoint full)" >&2; exit 2 ;;
+  *) echo "unknown step $step (train export ship eval paper disjoint full)" >&2; exit 2 ;;
   esac
 done

@@ -146,3 +146,26 @@ def test_coord_plan_and_its_errors(tmp_path):
 def test_gurobi_without_gurobipy_is_a_clear_error(tmp_path):
     out = ara("coord", "exp2", "--out", str(tmp_path / "e"), "--solver", "gurobi")
     assert out.returncode == 2 and "needs gurobipy" in out.stderr
+
+
+def test_explain_reads_a_formula_back_in_english():
+    """Tests `ara stl explain`, as text and as JSON."""
+    out = ara("stl", "explain", "G(door_open -> F[0,5](close_door))")
+    assert out.returncode == 0 and out.stdout == "whenever door_open, close_door within 5 steps\n"
+    out = ara("stl", "explain", "F(a & F(b))", "--json")
+    assert json.loads(out.stdout) == {"stl": "F(a & F(b))", "english": "first a, then b"}
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["", "--aps", "a"], "the instruction is empty"),
+        (["go to the kitchen", "--aps", "go_to_kitchen,pick_red_box"],
+         "never mentions pick_red_box"),  # a proposition the sentence never names
+        (["reach prop_1 within 5000 steps", "--aps", "prop_1"], "pass --max-bound 5000"),
+    ],
+)
+def test_translate_refuses_a_request_it_cannot_honour(args, message):
+    """Tests that bad translation requests exit 2 with the fix, before any model loads."""
+    out = ara("translate", *args)
+    assert out.returncode == 2 and message in out.stderr and "Traceback" not in out.stderr

@@ -78,7 +78,7 @@ class DataSettings:
     """Which records to train on.
 
     Args:
-        split: Prepared split (``paper``, ``disjoint``, ``timed``).
+        split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``).
         seed: Seed the split was prepared with.
         forms: ``lifted``, ``grounded`` or both.
         limit: Use only the first N training records (``None``: all).

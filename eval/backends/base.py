@@ -44,6 +44,24 @@ class Completion:
     masked_steps: int = 0
 
 
+@dataclass(frozen=True)
+class Sampling:
+    """Draw tokens from the model's distribution instead of taking the best one.
+
+    Args:
+        temperature: Softmax temperature, > 0 (lower is closer to greedy).
+        seed: Seeds the draws, so one (prompt, seed) gives one answer.
+    """
+
+    temperature: float = 0.7
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not self.temperature > 0:
+            raise BackendError(f"sampling temperature must be > 0, got {self.temperature}; "
+                               "for greedy decoding pass no Sampling")
+
+
 class Backend(Protocol):
     """A model that completes prompts, optionally under a grammar."""
 
@@ -51,13 +69,15 @@ class Backend(Protocol):
     model_id: str
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
-                 stop: str) -> Completion:
-        """Greedy completion of ``prompt``.
+                 stop: str, sampling: Sampling | None = None) -> Completion:
+        """Completion of ``prompt``: greedy, or sampled with ``sampling``.
 
         Args:
             prompt: The full prompt.
             grammar: Constrain the answer to this grammar's language, or ``None``.
             max_tokens: Token budget for the answer.
             stop: Unconstrained generation ends at this string (not returned).
+            sampling: Draw tokens (seeded) instead of taking the argmax; backends that
+                cannot raise :class:`BackendError`.
         """
         ...

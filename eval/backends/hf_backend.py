@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ara.eval.backends.base import BackendError, Completion
-from ara.eval.backends.masking import GrammarMatcher, greedy_decode
+from ara.eval.backends.base import BackendError, Completion, Sampling
+from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
 from ara.grammars import BuiltGrammar
 
 MASK_ENGINES = ("llguidance", "outlines")
@@ -115,10 +115,12 @@ class HFBackend:
         return self._forward(ids[reused:]), reused
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
-                 stop: str) -> Completion:
+                 stop: str, sampling: Sampling | None = None) -> Completion:
         if grammar is not None and self.mask == "llguidance":
             self.lltokenizer  # noqa: B018 - built once, outside the timed call
         if grammar is not None and self.mask == "outlines":
+            if sampling is not None:
+                raise BackendError("sampling runs with the llguidance mask; pass mask='llguidance'")
             return self._complete_outlines(prompt, grammar, max_tokens)
         start = time.perf_counter()
         ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
@@ -126,7 +128,7 @@ class HFBackend:
         matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
         text, out, reason = greedy_decode(
             logits, lambda token: self._forward([token]), self.tokenizer.decode, matcher,
-            self._eos, max_tokens, stop)
+            self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
         return Completion(text, len(ids), len(out), reused, (time.perf_counter() - start) * 1e3,
                           reason, matcher.masked_steps if matcher else 0)
 

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ara.eval.backends.base import BackendError, Completion
-from ara.eval.backends.masking import GrammarMatcher, greedy_decode
+from ara.eval.backends.base import BackendError, Completion, Sampling
+from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
 from ara.grammars import BuiltGrammar
 from ara.grammars.llama_check import muted_llama_log
 from ara.provenance import sha256_file
@@ -103,7 +103,7 @@ class LlamaCppBackend:
         return reused
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
-                 stop: str) -> Completion:
+                 stop: str, sampling: Sampling | None = None) -> Completion:
         if grammar is not None and self.mask == "llguidance":
             self.lltokenizer  # noqa: B018 - built once, outside the timed call
         start = time.perf_counter()
@@ -115,6 +115,8 @@ class LlamaCppBackend:
             )
         reused = self._feed_prompt(tokens)
         if grammar is not None and self.mask == "llama":
+            if sampling is not None:
+                raise BackendError("sampling runs with the llguidance mask; pass mask='llguidance'")
             return self._complete_llama_grammar(grammar, max_tokens, len(tokens), reused, start)
         matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
 
@@ -125,7 +127,7 @@ class LlamaCppBackend:
         text, out, reason = greedy_decode(
             self._logits(), advance,
             lambda ids: self.llm.detokenize(ids).decode("utf-8", errors="replace"),
-            matcher, self._eos, max_tokens, stop)
+            matcher, self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
         return Completion(text, len(tokens), len(out), reused,
                           (time.perf_counter() - start) * 1e3, reason,
                           matcher.masked_steps if matcher else 0)

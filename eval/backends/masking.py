@@ -15,6 +15,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ara.eval.backends.base import Sampling
 from ara.grammars import BuiltGrammar
 
 
@@ -32,26 +33,47 @@ class GrammarMatcher:
         self._mask = np.zeros(self._n_words, dtype=np.int32)
         self.masked_steps = 0
 
-    def choose(self, logits: np.ndarray) -> int:
-        """The highest-scoring token the grammar allows next, and consume it."""
-        token = int(np.argmax(logits))
-        if token < self._n_words * 32 and self._matcher.try_consume_tokens([token]) == 1:
-            return token
+    def choose(self, logits: np.ndarray, sampler: Sampler | None = None) -> int:
+        """The highest-scoring token the grammar allows next (or one drawn from the
+        allowed tokens' distribution, with ``sampler``), and consume it."""
+        if sampler is None:
+            token = int(np.argmax(logits))
+            if token < self._n_words * 32 and self._matcher.try_consume_tokens([token]) == 1:
+                return token
         self.masked_steps += 1
         self._matcher.unsafe_compute_mask_ptr(self._mask.ctypes.data, self._mask.nbytes)
         allowed = allowed_tokens(self._mask, len(logits))
         if allowed.size == 0:
             raise RuntimeError(f"grammar allows no token: {self._matcher.get_error()}")
-        token = int(allowed[np.argmax(logits[allowed])])
+        scores = logits[allowed]
+        token = int(allowed[np.argmax(scores) if sampler is None else sampler(scores)])
         if not self._matcher.consume_token(token):
             raise RuntimeError(f"llguidance refused its own mask: {self._matcher.get_error()}")
         return token
 
 
+class Sampler:
+    """Draws a token index from ``softmax(scores / temperature)``, seeded.
+
+    Sampling from the allowed tokens' renormalized distribution is sampling from the
+    model conditioned on the grammar, one step at a time.
+    """
+
+    def __init__(self, sampling: Sampling) -> None:
+        self.temperature = sampling.temperature
+        self.rng = np.random.default_rng(sampling.seed)
+
+    def __call__(self, scores: np.ndarray) -> int:
+        z = (scores.astype(np.float64) - scores.max()) / self.temperature
+        p = np.exp(z)
+        return int(self.rng.choice(len(p), p=p / p.sum()))
+
+
 def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
                   detokenize: Callable[[list[int]], str], matcher: GrammarMatcher | None,
-                  eos: set[int], max_tokens: int, stop: str) -> tuple[str, list[int], str]:
-    """The greedy loop both local backends share.
+                  eos: set[int], max_tokens: int, stop: str,
+                  sampler: Sampler | None = None) -> tuple[str, list[int], str]:
+    """The decoding loop both local backends share: greedy, or sampled with ``sampler``.
 
     Args:
         logits: Scores after the prompt.
@@ -61,6 +83,7 @@ def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
         eos: Tokens that end generation (the grammar allows them once it is complete).
         max_tokens: Token budget.
         stop: Free decoding ends at this string, which is not returned.
+        sampler: Draw each token instead of taking the argmax.
 
     Returns:
         ``(text, tokens, reason)`` with reason ``eos``, ``stop`` or ``length``.
@@ -68,7 +91,10 @@ def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
     out: list[int] = []
     text = ""
     for _ in range(max_tokens):
-        token = matcher.choose(logits) if matcher else int(np.argmax(logits))
+        if matcher is not None:
+            token = matcher.choose(logits, sampler)
+        else:
+            token = int(np.argmax(logits)) if sampler is None else sampler(logits)
         if token in eos:
             return text, out, "eos"
         out.append(token)

@@ -15,7 +15,7 @@ import time
 import urllib.error
 import urllib.request
 
-from ara.eval.backends.base import BackendError, Completion
+from ara.eval.backends.base import BackendError, Completion, Sampling
 from ara.grammars import BuiltGrammar
 
 
@@ -55,7 +55,9 @@ class OpenAIBackend:
             ) from err
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
-                 stop: str) -> Completion:
+                 stop: str, sampling: Sampling | None = None) -> Completion:
+        if sampling is not None:
+            raise BackendError("sampling (self-consistency) runs on local models only")
         if grammar is not None:
             raise BackendError(
                 "an HTTP endpoint decodes freely: run constrained variants (C) with a local "

@@ -11,9 +11,11 @@ from ara.errors import ConfigError, DataVersionError
 
 @pytest.fixture(scope="module")
 def prepared_root(tmp_path_factory):
-    """A root with the three splits prepared (seed 0)."""
+    """A root with every split prepared (seed 0)."""
+    from ara.data import SPLITS
+
     root = tmp_path_factory.mktemp("prepared")
-    for split in ("paper", "disjoint", "timed"):
+    for split in SPLITS:
         prepare(split, 0, root)
     return root
 
@@ -21,8 +23,9 @@ def prepared_root(tmp_path_factory):
 def test_prepared_versions_are_the_registered_ones(prepared_root):
     """Tests that this release prepares exactly the versions versions.json registers.
 
-    A failure means the normalizer or the raw data changed the prepared contents:
-    bump NORMALIZER_VERSION and register the new versions, never edit silently.
+    A failure means the normalizer, the synthetic generator, the realizer, the suite or
+    the raw data changed the prepared contents: bump NORMALIZER_VERSION (or
+    SYNTHETIC_VERSION) and register the new versions, never edit silently.
     """
     found = {p.name.rsplit("-", 1)[0]: p.name.rsplit("-", 1)[1]
              for p in prepared_root.iterdir() if not p.name.startswith(".")}

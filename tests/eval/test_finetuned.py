@@ -1,10 +1,24 @@
-"""The shipped fine-tune: what `--model finetuned` gives a user out of the box."""
+"""The shipped fine-tunes: what `--model finetuned` (and `finetuned-paper`) give a user."""
 
 import json
+import random
 
 import pytest
 
-from ara.eval.models import FINETUNED_LORA, make_backend
+from ara.eval.harness import judge
+from ara.eval.models import FINETUNED_LORA, PAPER_LORA, make_backend
+from ara.eval.translator import Translator
+
+#: The sentences of the issue that asked for generalization, with their references
+#: (the hand-written suite's first entries): none occurs in any training file.
+NEVER_SEEN = [
+    ("eventually ( prop_2 ) and always ( prop_1 )", "F(prop_2) & G(prop_1)"),
+    ("at no time ( prop_1 )", "G(!prop_1)"),
+    ("go to ( prop_1 ) and after that ( prop_2 )", "F(prop_1 & F(prop_2))"),
+    ("visit ( prop_1 ) over and over again", "G(F(prop_1))"),
+    ("within 20 steps reach ( prop_1 )", "F[0,20](prop_1)"),
+    ("do not ( prop_1 ) during the first 7 steps", "G[0,7](!prop_1)"),
+]
 
 
 @pytest.fixture(scope="module")
@@ -14,57 +28,72 @@ def finetuned(embedded_model_path):
     return make_backend("finetuned")
 
 
-def test_the_adapter_is_the_one_its_manifest_describes():
-    if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
+@pytest.mark.parametrize(("adapter", "version"), [
+    (FINETUNED_LORA, "7694e7d55174"),  # the registered compositional mixture
+    (PAPER_LORA, "1de1d813ead6"),  # the registered paper split
+])
+def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
+    """Tests hash, training data version and export parity of each shipped adapter."""
+    if not adapter.is_file():
+        pytest.skip(f"no shipped adapter at {adapter}")
     from ara.provenance import sha256_file
 
-    manifest = json.loads(FINETUNED_LORA.with_suffix(".json").read_text())
-    assert manifest["sha256"] == sha256_file(FINETUNED_LORA)
-    assert manifest["run"]["data"]["version"] == "1de1d813ead6"  # the registered paper split
+    manifest = json.loads(adapter.with_suffix(".json").read_text())
+    assert manifest["file"] == adapter.name
+    assert manifest["sha256"] == sha256_file(adapter)
+    assert manifest["run"]["data"]["version"] == version
     assert manifest["export"]["parity"]["agreement"] == 1.0
 
 
-def test_finetuned_translates_test_pairs_the_base_model_gets_wrong(finetuned, llama_backend,
-                                                                   paper_split):
-    """Zero-shot, grammar-constrained, on 12 grounded test pairs of the paper split: the
-    fine-tune's answers are Spot-equivalent to the references, the base model's are not."""
-    from ara.eval.harness import judge
-    from ara.eval.translator import Translator
-
-    pairs = paper_split.records("test", "grounded")[:12]
-
-    def correct(backend):
-        t = Translator(backend)
-        return sum(bool(judge(r.stl, t.translate(r.nl, r.aps).stl, timeout_s=10)["equivalent"])
-                   for r in pairs)
-
-    tuned, base = correct(finetuned), correct(llama_backend)
-    assert tuned >= 11 and base <= 6, (tuned, base)
+def correct(backend, pairs, shots=()) -> int:
+    t = Translator(backend)
+    return sum(bool(judge(stl, t.translate(nl, aps, shots).stl, timeout_s=10)["equivalent"])
+               for nl, aps, stl in pairs)
 
 
-def test_finetuned_also_translates_with_worked_examples(finetuned, paper_split):
-    """With 5 worked examples in the prompt (variant F+C), as with none: the adapter
-    trained on a mix of 0- to 20-shot prompts, so examples do not derail it."""
-    import random
+def test_finetuned_translates_sentences_it_never_saw(finetuned, llama_backend):
+    """Zero-shot, under the default grammar (time bounds allowed): the issue's six
+    sentences, which the earlier adapter got wrong; the base model gets them wrong too."""
+    from ara.grammars import atoms, parse
 
-    from ara.eval.harness import judge
-    from ara.eval.prompt import sample_shots
-    from ara.eval.translator import Translator
+    pairs = [(nl, tuple(sorted(atoms(parse(stl)))), stl) for nl, stl in NEVER_SEEN]
+    tuned, base = correct(finetuned, pairs), correct(llama_backend, pairs)
+    assert tuned >= 5 and base <= 1, (tuned, base)
 
-    shots = sample_shots(paper_split.records("train", "grounded"), 5, random.Random(0))
-    pairs = paper_split.records("test", "grounded")[12:24]
+
+def test_an_untimed_sentence_comes_out_untimed(finetuned):
+    """Tests that allowing time bounds by default does not invent them: untimed
+    hand-written instructions get untimed answers."""
+    from ara.data import load_or_prepare
+
+    untimed = [r for r in load_or_prepare("handwritten").records("test", "grounded")
+               if "[" not in r.stl][:12]
     t = Translator(finetuned)
-    right = sum(bool(judge(r.stl, t.translate(r.nl, r.aps, shots).stl, timeout_s=10)["equivalent"])
-                for r in pairs)
-    assert right >= 11, right
+    answers = [t.translate(r.nl, r.aps).stl for r in untimed]
+    assert all("[" not in a for a in answers), answers
 
 
-def test_lora_names_any_adapter_for_the_embedded_base(finetuned, tmp_path):
-    """Tests ``--model lora:PATH``: the shipped adapter by path is the ``finetuned``
-    model, and a missing file says how to make one."""
+def test_finetuned_translates_paper_pairs_with_and_without_worked_examples(finetuned,
+                                                                          paper_split):
+    """On grounded paper-split test pairs: zero-shot, and with 5 worked examples from the
+    compositional train side (variant F+C), most answers are right."""
+    from ara.data import load_or_prepare
+    from ara.eval.prompt import sample_shots
+
+    pairs = [(r.nl, r.aps, r.stl) for r in paper_split.records("test", "grounded")[:12]]
+    shots = sample_shots(load_or_prepare("compositional").records("train", "grounded"), 5,
+                         random.Random(0))
+    zero, five = correct(finetuned, pairs), correct(finetuned, pairs, shots)
+    assert zero >= 10 and five >= 10, (zero, five)
+
+
+def test_names_reach_every_shipped_adapter(finetuned, tmp_path):
+    """Tests ``--model lora:PATH`` (the shipped adapter by path is ``finetuned``),
+    ``finetuned-paper``, and the message for a missing file."""
     from ara.eval.backends.base import BackendError
 
     assert make_backend(f"lora:{FINETUNED_LORA}").model_id == finetuned.model_id
+    if PAPER_LORA.is_file():
+        assert make_backend("finetuned-paper").model_id != finetuned.model_id
     with pytest.raises(BackendError, match="ara export --lora-gguf"):
         make_backend(f"lora:{tmp_path / 'missing.gguf'}")

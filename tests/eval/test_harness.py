@@ -54,7 +54,30 @@ def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):
     assert rerun_examples[0] != rerun_examples[1]  # examples are redrawn per rerun
 
 
-def test_timed_split_turns_intervals_on():
-    """Tests that the timed split's grammar can express its references."""
-    assert AblationConfig(split="timed").translator.intervals is True
-    assert AblationConfig(split="paper").translator.intervals is False
+def test_grammars_admit_intervals_and_the_timed_split_insists():
+    """Tests that intervals are on by default, and that the timed split keeps them on
+    even when a config turns them off (its references need them)."""
+    from ara.eval.translator import TranslatorConfig
+
+    assert AblationConfig(split="paper").translator.intervals is True
+    off = TranslatorConfig(intervals=False)
+    assert AblationConfig(split="paper", translator=off).translator.intervals is False
+    assert AblationConfig(split="timed", translator=off).translator.intervals is True
+
+
+def test_a_test_only_split_borrows_worked_examples_from_the_compositional_train_side():
+    """Tests that the hand-written suite (no train side) gets its F examples from the
+    compositional mixture, and that zero-shot runs of it need no pool at all."""
+    from ara.data import load_or_prepare
+
+    split = load_or_prepare("handwritten")
+    config = AblationConfig(split="handwritten", form="grounded", variants=("C", "F+C"),
+                            shots=(3,), reruns=1, limit=5)
+    jobs = list(plan(config, split))
+    train = {r.nl for r in load_or_prepare("compositional").records("train", "grounded")}
+    examples = {s.nl for j in jobs for s in j.examples}
+    assert len(examples) == 3 and examples <= train
+    suite = {r.nl for r in split.records("test")}
+    assert not examples & suite
+    zero = AblationConfig(split="handwritten", variants=("C",), reruns=1, limit=5)
+    assert all(j.examples == () for j in plan(zero, split))

@@ -8,8 +8,8 @@ import pytest
 from ara.eval.backends.base import BackendError
 from ara.eval.backends.masking import allowed_tokens
 from ara.eval.prompt import STOP, build_prompt, sample_shots
-from ara.eval.translator import ANSWER_PREFIX, Translator, TranslatorConfig
-from ara.grammars import BuiltGrammar, Syntax, build_grammar
+from ara.eval.translator import Translator, TranslatorConfig
+from ara.grammars import Syntax, build_grammar
 
 
 def test_allowed_tokens_unpacks_an_llguidance_bitmask():
@@ -30,8 +30,11 @@ def test_missing_model_file_is_a_clear_error(tmp_path):
 
 
 def decoding_grammar(aps, **kwargs):
-    built = build_grammar(Syntax(aps=tuple(aps), max_depth=5, max_args=2, **kwargs))
-    return BuiltGrammar(built.syntax, built.grammar.with_prefix(ANSWER_PREFIX))
+    """The translator's own decoding grammar for ``aps``."""
+    from ara.eval.translator import decoding_grammar as translator_grammar
+
+    return translator_grammar(build_grammar(Syntax(aps=tuple(aps), max_depth=5, max_args=2,
+                                                   **kwargs)))
 
 
 def test_constrained_outputs_always_belong_to_the_language(llama_backend, paper_split):

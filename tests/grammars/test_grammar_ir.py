@@ -9,6 +9,8 @@ from ara.grammars import GRAMMAR_VERSION, Syntax, build_grammar
 from ara.grammars.grammar_ir import Chars, Lit
 from ara.grammars.stl_grammar import number_patterns
 
+from conftest import needs_llama
+
 
 def _matches(pattern, text):
     if len(pattern) != len(text):
@@ -66,6 +68,26 @@ def test_grammar_needs_propositions():
     """Tests that a grammar is built per request, from its propositions."""
     with pytest.raises(ConfigError, match="give aps"):
         build_grammar(Syntax())
+
+
+@needs_llama
+def test_with_suffix_adds_exactly_the_suffix_newlines_included():
+    """Tests the decoding grammar ' ' + formula + newline: both formats escape the
+    newline, and a formula without it, or with anything after it, is refused."""
+    import lark
+
+    from ara.grammars.llama_check import LlamaGrammarChecker
+
+    grammar = build_grammar(Syntax(aps=("a", "b"))).grammar.with_prefix(" ").with_suffix("\n")
+    assert '"\\n"' in grammar.to_gbnf() and '"\\n"' in grammar.to_lark()
+    parser = lark.Lark(grammar.to_lark(), start="start", parser="earley", lexer="dynamic")
+    parser.parse(" F(a) & b\n")
+    for bad in (" F(a) & b", " F(a) & b\n\n", " F(a)\n & b"):
+        with pytest.raises(lark.exceptions.LarkError):
+            parser.parse(bad)
+    assert grammar.min_lengths()[grammar.root] == 3
+    checker = LlamaGrammarChecker(grammar.to_gbnf())
+    assert checker.accepts(" F(a) & b\n") and not checker.accepts(" F(a) & b")
 
 
 def test_with_prefix_adds_exactly_the_prefix():

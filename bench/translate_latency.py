@@ -1,0 +1,58 @@
+"""Latency of `ara translate` as users get it, before and after the compositional
+fine-tune, measured side by side in one run on the same sentences.
+
+    .venv/bin/python bench/translate_latency.py [--n 40]
+
+Rows: the earlier default (paper-split adapter, grammar without time bounds), the new
+default (compositional adapter, grammar with time bounds up to 1000), and the new
+adapter without time bounds (what the bigger grammar itself costs). Zero-shot, greedy,
+under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one warm-up
+call first. A formula's time depends on its length, so tokens per answer are shown too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import random
+import statistics
+
+from ara.data import load_or_prepare
+from ara.eval.models import make_backend
+from ara.eval.translator import Translator, TranslatorConfig
+
+
+def measure(translator: Translator, records) -> dict:
+    translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
+    runs = [translator.translate(r.nl, r.aps) for r in records]
+    ms = [r.ms for r in runs]
+    return {"median_ms": statistics.median(ms), "mean_ms": statistics.fmean(ms),
+            "tokens": statistics.fmean(r.completion_tokens for r in runs)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=40, help="hand-written instructions")
+    args = ap.parse_args()
+    records = random.Random(0).sample(load_or_prepare("handwritten").records("test", "grounded"),
+                                      args.n)
+    print(f"# {args.n} hand-written grounded instructions, zero-shot, greedy, constrained; "
+          f"{platform.machine()}, {os.cpu_count()} cores")
+    print("| model | grammar | median ms/formula | mean ms/formula | tokens/answer | "
+          "median vs earlier default |")
+    print("|---|---|---:|---:|---:|---:|")
+    rows = [("finetuned-paper", False, "earlier default"), ("finetuned", True, "new default"),
+            ("finetuned", False, "new adapter")]
+    base = None
+    for model, intervals, label in rows:
+        t = Translator(make_backend(model), TranslatorConfig(intervals=intervals))
+        m = measure(t, records)
+        base = base or m["median_ms"]
+        print(f"| {model} ({label}) | {'with' if intervals else 'no'} time bounds | "
+              f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {m['tokens']:.1f} | "
+              f"{m['median_ms'] / base:.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,73 @@
+"""The hand-written suite (``handwritten/suite.yaml``): instructions written for this
+project as a user would, each with its reference and the readings it must not be
+confused with. Test only: no training mixture includes it.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from ara.data.normalize import Record, _UidMaker
+from ara.errors import ConfigError
+from ara.grammars import atoms, parse, to_text
+
+SUITE = Path(__file__).parent / "handwritten" / "suite.yaml"
+SOURCE = "handwritten"
+_LIFTED = re.compile(r"prop_\d+")
+
+
+@dataclass(frozen=True)
+class SuiteEntry:
+    """One instruction of the suite.
+
+    Attributes:
+        nl: The instruction.
+        stl: Its reference formula, canonical.
+        confusions: Readings a translator could plausibly give instead (canonical).
+        domain: ``lifted``, ``navigation``, ``manipulation`` or ``warehouse``.
+    """
+
+    nl: str
+    stl: str
+    confusions: tuple[str, ...]
+    domain: str
+
+    @property
+    def aps(self) -> tuple[str, ...]:
+        return tuple(sorted(atoms(parse(self.stl))))
+
+    @property
+    def form(self) -> str:
+        return "lifted" if all(_LIFTED.fullmatch(a) for a in self.aps) else "grounded"
+
+
+def load_suite(path: Path = SUITE) -> list[SuiteEntry]:
+    """The suite's entries, with every formula parsed and printed canonically.
+
+    Raises:
+        ConfigError: If an entry lacks a field or a formula does not parse.
+    """
+    data = yaml.safe_load(path.read_text())
+    entries = []
+    for i, item in enumerate(data["entries"]):
+        missing = {"nl", "stl", "not", "domain"} - set(item)
+        if missing:
+            raise ConfigError(f"{path.name} entry {i} lacks {sorted(missing)}: {item}")
+        try:
+            stl = to_text(parse(item["stl"]))
+            confusions = tuple(to_text(parse(c)) for c in item["not"])
+        except ValueError as err:
+            raise ConfigError(f"{path.name} entry {i} ({item['nl']!r}): {err}") from err
+        entries.append(SuiteEntry(item["nl"], stl, confusions, item["domain"]))
+    return entries
+
+
+def suite_records(path: Path = SUITE) -> list[Record]:
+    """The suite as test records (row = position in the file)."""
+    uid = _UidMaker()
+    return [Record(uid(SOURCE, e.form, e.nl, e.stl), e.nl, e.stl, e.aps, SOURCE, e.form, i)
+            for i, e in enumerate(load_suite(path))]

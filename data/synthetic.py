@@ -1,0 +1,249 @@
+"""Seeded synthetic NL/STL pairs: formulas drawn from the project's own language,
+worded by the English realizer (:mod:`ara.grammars.english`).
+
+Half of the formulas are patterns users write (reach, avoid, sequence, response,
+recurrence, persistence, bounded reach and avoid, until), 28% two patterns joined by a
+connective, and 22% grow at random over every operator of the grammar (``!``, ``&``,
+``|``, ``->``, ``<->``, ``F``, ``G``, ``U``, each temporal one timed or not) up to depth
+4. A formula has 1 to 5 propositions, and one may occur twice. Each row is worded
+twice: lifted (``prop_1``...) and grounded (``go_to_kitchen``...).
+
+The compositional test split holds out *shapes* (a formula with its propositions
+renamed in order and its bounds blanked, with at least three operators) and the
+held-out phrasings of the realizer; training sees neither.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import random
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from ara.data.normalize import Record, _UidMaker
+from ara.data.vocabulary import Proposition, draw_propositions
+from ara.errors import ConfigError
+from ara.grammars.ast import (
+    Always,
+    And,
+    Atom,
+    Eventually,
+    Formula,
+    Iff,
+    Implies,
+    Interval,
+    Not,
+    Or,
+    Until,
+    atoms,
+    depth,
+    map_children,
+    rename_atoms,
+    walk,
+)
+from ara.grammars.english import UNITS, Realizer, realize
+from ara.grammars.printer import to_text
+from ara.grammars.syntax import Syntax
+
+SYNTHETIC_VERSION = "1.0.0"
+SOURCE = "synthetic"
+
+
+@dataclass(frozen=True)
+class SynthSettings:
+    """What the generator draws.
+
+    Args:
+        max_depth: Deepest operator nesting, 1..4.
+        max_props: Most distinct propositions per formula, 1..5.
+        timed: Probability that a temporal operator carries an interval, in [0, 1].
+        max_bound: Largest interval bound, >= 2 (the decoding grammar's is 1000).
+        held_out_percent: Share of eligible shapes kept for the test split, 0..50.
+    """
+
+    max_depth: int = 4
+    max_props: int = 5
+    timed: float = 0.3
+    max_bound: int = 1000
+    held_out_percent: int = 15
+
+    def __post_init__(self) -> None:
+        if not (1 <= self.max_depth <= 4 and 1 <= self.max_props <= 5 and 0 <= self.timed <= 1
+                and self.max_bound >= 2 and 0 <= self.held_out_percent <= 50):
+            raise ConfigError(f"synthetic settings out of range: {self}")
+
+
+# -- formulas ---------------------------------------------------------------------------
+
+def _interval(rng: random.Random, s: SynthSettings, window: bool) -> Interval:
+    top = rng.choice((20, 20, 100, s.max_bound))
+    hi = rng.randint(2, min(top, s.max_bound))
+    return Interval(rng.randint(1, hi - 1), hi) if window else Interval(0, hi)
+
+
+def _maybe_interval(rng: random.Random, s: SynthSettings) -> Interval | None:
+    return _interval(rng, s, rng.random() < 0.4) if rng.random() < s.timed else None
+
+
+def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) -> Formula:
+    """One pattern users write, over leaves (propositions or small formulas)."""
+    a, b = leaf(), leaf()
+    iv = _maybe_interval(rng, s)
+    bounded = iv if iv is not None and iv.lo == 0 else None
+    choices: list[Callable[[], Formula]] = [
+        lambda: Eventually(a, iv), lambda: Always(a, iv), lambda: Always(Not(a), iv),
+        lambda: Eventually(Always(a)), lambda: Always(Eventually(a)),
+        lambda: Eventually(And((a, Eventually(b)))),
+        lambda: Eventually(And((a, Eventually(And((b, Eventually(leaf()))))))),
+        lambda: Always(Implies(a, Eventually(b, bounded))), lambda: Always(Implies(a, b)),
+        lambda: Until(a, b, iv), lambda: Until(Not(a), b),
+        lambda: Implies(a, Eventually(b, iv)), lambda: Eventually(a, iv),
+        lambda: Always(Not(a), iv),
+    ]
+    return rng.choice(choices)()
+
+
+def _random(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula],
+            budget: int) -> Formula:
+    """A formula grown uniformly over the grammar's operators, at most ``budget`` deep."""
+    if budget == 0 or rng.random() < 0.25:
+        return leaf()
+
+    def sub() -> Formula:
+        return _random(rng, s, leaf, budget - 1)
+
+    op = rng.choice(("!", "&", "|", "->", "<->", "F", "G", "U", "F", "G"))
+    if op == "!":
+        return Not(sub())
+    if op in ("&", "|"):
+        return (And if op == "&" else Or)((sub(), sub()))
+    if op == "->":
+        return Implies(sub(), sub())
+    if op == "<->":
+        return Iff(sub(), sub())
+    if op == "U":
+        return Until(sub(), sub(), _maybe_interval(rng, s))
+    return (Eventually if op == "F" else Always)(sub(), _maybe_interval(rng, s))
+
+
+def _leaf_drawer(rng: random.Random, names: list[str]) -> Callable[[], Formula]:
+    """Leaves that take each proposition once before any repeats, and repeat only now
+    and then: "a & a" teaches nothing."""
+    fresh = rng.sample(names, len(names))
+
+    def leaf() -> Formula:
+        if fresh and rng.random() > 0.08:
+            return Atom(fresh.pop())
+        return Atom(rng.choice(names))
+
+    return leaf
+
+
+def sample_formula(rng: random.Random, s: SynthSettings, names: list[str]) -> Formula:
+    """A formula over (some of) ``names``, within ``s.max_depth``; binary & and |."""
+    while True:
+        leaf = _leaf_drawer(rng, names)
+        kind = rng.random()
+        if kind < 0.5:
+            f = _pattern(rng, s, leaf)
+        elif kind < 0.78:
+            op = rng.choice((And, Or, And, Implies, Iff))
+            parts = (_pattern(rng, s, leaf), _pattern(rng, s, leaf))
+            f = op(parts) if op in (And, Or) else op(*parts)
+        else:
+            f = _random(rng, s, leaf, rng.randint(2, s.max_depth))
+        if 1 <= depth(f) <= s.max_depth:
+            return f
+
+
+def shape(f: Formula) -> str:
+    """``f`` with propositions renamed ``p1, p2, ...`` in order and bounds blanked."""
+    order = list(dict.fromkeys(n.name for n in walk(f) if isinstance(n, Atom)))
+    renamed = rename_atoms(f, {name: f"p{i + 1}" for i, name in enumerate(order)})
+    return to_text(_blank(renamed))
+
+
+def _blank(f: Formula) -> Formula:
+    iv = getattr(f, "interval", None)
+    f = map_children(f, _blank)
+    if iv is not None:
+        f = replace(f, interval=Interval(0, 1) if iv.lo == 0 else Interval(1, 2))
+    return f
+
+
+def is_held_out(f: Formula, s: SynthSettings) -> bool:
+    """Whether ``f``'s shape belongs to the compositional test split."""
+    operators = sum(not isinstance(n, Atom) for n in walk(f))
+    key = int(hashlib.sha256(shape(f).encode()).hexdigest()[:8], 16)
+    return operators >= 3 and key % 100 < s.held_out_percent
+
+
+# -- records ----------------------------------------------------------------------------
+
+def _lifted_atom(rng: random.Random) -> Callable[[str], str]:
+    style = rng.choice(("({})", "({})", "( {} )", "{}"))
+    return style.format
+
+
+def _word(f: Formula, rng: random.Random, mode: str, say, is_action) -> str:
+    return realize(f, Realizer(rng=rng, mode=mode, unit=rng.randrange(len(UNITS)),
+                               say_atom=say, is_action=is_action))
+
+
+def pair(rng: random.Random, s: SynthSettings, mode: str,
+         want_held_out: bool) -> tuple[Formula, str, Formula, str] | None:
+    """One row: (lifted formula, sentence, grounded formula, sentence), or ``None``
+    when the drawn shape is on the other side of the split."""
+    # Every leaf takes a new proposition until max_props are in use, so the count
+    # follows the formula's size; a repeat now and then (see sample_formula).
+    f = sample_formula(rng, s, [f"x{i}" for i in range(s.max_props)])
+    if is_held_out(f, s) != want_held_out:
+        return None
+    used = sorted(atoms(f), key=lambda n: to_text(f).index(n))
+    if rng.random() < 0.6:
+        lifted_names = {x: f"prop_{i + 1}" for i, x in enumerate(used)}
+    else:
+        numbers = rng.sample(range(1, len(used) + 1), len(used))
+        lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
+    lifted = rename_atoms(f, lifted_names)
+    lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
+    props: list[Proposition] = draw_propositions(rng, len(used))
+    by_x = dict(zip(used, props, strict=True))
+    grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
+    by_name = {p.name: p for p in props}
+    phrase = {p.name: rng.choice(p.phrases) for p in props}
+    grounded_nl = _word(grounded, rng, mode, phrase.__getitem__,
+                        lambda name: by_name[name].action)
+    return lifted, lifted_nl, grounded, grounded_nl
+
+
+def synthetic_records(rows: int, seed: int, held_out: bool,
+                      settings: SynthSettings | None = None) -> list[Record]:
+    """``rows`` rows, each as a lifted and a grounded record.
+
+    Args:
+        rows: Number of distinct formulas (rows) to produce.
+        seed: Seeds everything drawn.
+        held_out: Test side (held-out shapes, held-out phrasings preferred) or train
+            side (neither).
+        settings: What to draw; :class:`SynthSettings` defaults if ``None``.
+    """
+    s = settings or SynthSettings()
+    rng = random.Random(f"{seed}:{'test' if held_out else 'train'}:{SYNTHETIC_VERSION}")
+    mode = "test" if held_out else "train"
+    syntax = Syntax(aps=None, intervals=True, max_bound=s.max_bound, max_depth=5, max_args=2)
+    uid, records, seen = _UidMaker(), [], set()
+    while len(records) < 2 * rows:
+        drawn = pair(rng, s, mode, held_out)
+        if drawn is None:
+            continue
+        lifted, lifted_nl, grounded, grounded_nl = drawn
+        if (lifted_nl, to_text(lifted)) in seen or not syntax.accepts(to_text(grounded)):
+            continue
+        seen.add((lifted_nl, to_text(lifted)))
+        row = len(records) // 2
+        for form, f, nl in (("lifted", lifted, lifted_nl), ("grounded", grounded, grounded_nl)):
+            stl = to_text(f)
+            records.append(Record(uid(SOURCE, form, nl, stl), nl, stl,
+                                  tuple(sorted(atoms(f))), SOURCE, form, row))
+    return records

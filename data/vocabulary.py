@@ -1,0 +1,105 @@
+"""Grounded propositions for synthetic sentences: a name a formula uses
+(``go_to_kitchen``) and the words a person would say for it ("head to the kitchen").
+
+Actions read as imperatives ("do not pick up the red box"); conditions as clauses
+("the door is open"). Every name is a valid proposition of the surface syntax.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+
+PLACES = (
+    ("kitchen", "kitchen"), ("hallway", "hallway"), ("office", "office"), ("lab", "lab"),
+    ("garage", "garage"), ("lobby", "lobby"), ("elevator", "elevator"), ("exit", "exit"),
+    ("bedroom", "bedroom"), ("living_room", "living room"), ("storage_room", "storage room"),
+    ("charging_station", "charging station"), ("loading_bay", "loading bay"),
+    ("workshop", "workshop"), ("parking_lot", "parking lot"), ("front_door", "front door"),
+    ("warehouse", "warehouse"), ("reception", "reception"), ("corridor", "corridor"),
+)
+NUMBERED_PLACES = (("dock", "dock"), ("zone", "zone"), ("shelf", "shelf"),
+                   ("station", "station"), ("room", "room"), ("gate", "gate"))
+OBJECTS = (
+    ("red_box", "red box"), ("blue_cup", "blue cup"), ("green_block", "green block"),
+    ("package", "package"), ("tool", "tool"), ("bottle", "bottle"), ("book", "book"),
+    ("parcel", "parcel"), ("medicine", "medicine"), ("sample", "sample"),
+    ("yellow_ball", "yellow ball"), ("laptop", "laptop"), ("keys", "keys"), ("mug", "mug"),
+)
+NUMBERED_OBJECTS = (("pallet", "pallet"), ("crate", "crate"), ("bin", "bin"))
+
+PLACE_VERBS = (
+    ("go_to", ("go to the {x}", "go to {x}", "head to the {x}", "move to the {x}",
+               "navigate to the {x}", "drive to the {x}")),
+    ("visit", ("visit the {x}", "stop by the {x}", "visit {x}")),
+    ("reach", ("reach the {x}", "get to the {x}", "arrive at the {x}")),
+    ("enter", ("enter the {x}", "go into the {x}")),
+    ("leave", ("leave the {x}", "exit the {x}")),
+    ("at", ("be at the {x}", "be in the {x}", "stay at the {x}")),
+)
+OBJECT_VERBS = (
+    ("pick", ("pick up the {x}", "pick the {x}", "grab the {x}", "collect the {x}")),
+    ("place", ("place the {x}", "put down the {x}", "drop off the {x}")),
+    ("deliver", ("deliver the {x}", "bring the {x}")),
+    ("hold", ("hold the {x}", "carry the {x}")),
+    ("inspect", ("inspect the {x}", "check the {x}")),
+)
+STANDALONE_ACTIONS = (
+    ("charge", ("charge", "recharge the battery")), ("wait", ("wait", "stay still")),
+    ("beep", ("beep", "sound the horn")), ("report", ("report", "send a report")),
+)
+CONDITIONS = (
+    ("door_open", ("the door is open",)), ("battery_low", ("the battery is low",
+                                                          "the battery runs low")),
+    ("obstacle_detected", ("an obstacle is detected", "an obstacle is seen")),
+    ("person_nearby", ("a person is nearby", "someone is close by")),
+    ("alarm_on", ("the alarm is on", "the alarm goes off")),
+    ("light_red", ("the light is red",)), ("light_green", ("the light is green",)),
+    ("gripper_closed", ("the gripper is closed",)), ("task_done", ("the task is done",)),
+    ("path_blocked", ("the path is blocked",)), ("floor_wet", ("the floor is wet",)),
+    ("human_request", ("a human asks for help", "a person requests help")),
+)
+
+
+@dataclass(frozen=True)
+class Proposition:
+    """A grounded proposition and how it may be said."""
+
+    name: str
+    phrases: tuple[str, ...]
+    action: bool
+
+
+def draw_propositions(rng: random.Random, k: int) -> list[Proposition]:
+    """``k`` propositions with distinct names, mixing actions and conditions."""
+    found: dict[str, Proposition] = {}
+    while len(found) < k:
+        prop = _draw_one(rng)
+        found.setdefault(prop.name, prop)
+    return list(found.values())
+
+
+def _draw_one(rng: random.Random) -> Proposition:
+    kind = rng.random()
+    if kind < 0.45:
+        verb, phrases = rng.choice(PLACE_VERBS)
+        name, words = _thing(rng, PLACES, NUMBERED_PLACES)
+    elif kind < 0.8:
+        verb, phrases = rng.choice(OBJECT_VERBS)
+        name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    elif kind < 0.86:
+        verb, phrases = rng.choice(STANDALONE_ACTIONS)
+        return Proposition(verb, phrases, action=True)
+    else:
+        name, phrases = rng.choice(CONDITIONS)
+        return Proposition(name, phrases, action=False)
+    filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
+    return Proposition(f"{verb}_{name}", filled, action=True)
+
+
+def _thing(rng: random.Random, plain, numbered) -> tuple[str, str]:
+    if rng.random() < 0.35:
+        stem, words = rng.choice(numbered)
+        n = rng.randint(1, 12)
+        return f"{stem}_{n}", f"{words} {n}"
+    return rng.choice(plain)

@@ -1,0 +1,104 @@
+"""Semantic self-consistency: several answers under the grammar, grouped by meaning.
+
+The greedy answer and ``samples - 1`` sampled ones (seeded, under the same grammar, so
+all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
+``F(a | b)`` vote together. The largest group wins; a tie goes to the group holding the
+greedy answer, so with one sample this is plain greedy decoding. The cost is
+``samples`` generations plus the Spot checks between distinct answers.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ara.errors import ConfigError
+from ara.eval.backends.base import Sampling
+from ara.eval.prompt import Shot
+from ara.eval.translator import TranslationResult, Translator
+from ara.grammars import parse
+from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
+
+
+@dataclass(frozen=True)
+class Vote:
+    """The outcome of one self-consistent translation.
+
+    Attributes:
+        results: Every translation, greedy first.
+        groups: Indices into ``results``, one tuple per meaning, largest first.
+        ms: Wall time of all generations and checks.
+    """
+
+    results: tuple[TranslationResult, ...]
+    groups: tuple[tuple[int, ...], ...]
+    ms: float
+
+    @property
+    def result(self) -> TranslationResult:
+        """The winning answer: the first generated of the largest group."""
+        return self.results[self.groups[0][0]]
+
+    @property
+    def answers(self) -> tuple[str | None, ...]:
+        """Every answer's formula, greedy first (``None`` where one did not parse)."""
+        return tuple(r.stl for r in self.results)
+
+    @property
+    def agreement(self) -> float:
+        """Share of the answers in the winning group."""
+        return len(self.groups[0]) / len(self.answers)
+
+
+def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
+                         shots: Sequence[Shot] = (), samples: int = 5,
+                         temperature: float = 0.7, seed: int = 0,
+                         timeout_s: float = 10.0) -> Vote:
+    """Translate ``nl`` ``samples`` times under the grammar and keep the majority meaning.
+
+    Args:
+        translator: Any translator whose backend can sample (the local ones).
+        nl, aps, shots: As :meth:`Translator.translate`.
+        samples: Answers to draw, >= 1 (the first is greedy).
+        temperature: Sampling temperature, > 0.
+        seed: Answer ``i`` is drawn with seed ``seed + i``.
+        timeout_s: Spot's limit per comparison; an undecided pair counts as different.
+    """
+    if samples < 1:
+        raise ConfigError(f"samples must be >= 1, got {samples}")
+    start = time.perf_counter()
+    results = [translator.translate(nl, aps, shots)]
+    for i in range(1, samples):
+        sampling = Sampling(temperature=temperature, seed=seed + i)
+        results.append(translator.translate(nl, aps, shots, sampling=sampling))
+    groups = _group([r.stl for r in results], timeout_s)
+    ranked = sorted(groups, key=lambda g: (-len(g), g[0]))
+    return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
+
+
+def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, ...]]:
+    """Indices of equivalent answers together; unparsed answers each stand alone."""
+    groups: list[list[int]] = []
+    for i, text in enumerate(answers):
+        home = None
+        if text is not None:
+            for g in groups:
+                first = answers[g[0]]
+                if first is not None and _same(text, first, timeout_s):
+                    home = g
+                    break
+        if home is None:
+            groups.append([i])
+        else:
+            home.append(i)
+    return [tuple(g) for g in groups]
+
+
+def _same(a: str, b: str, timeout_s: float) -> bool:
+    if a == b:  # canonical texts: equal text, equal tree
+        return True
+    try:
+        return equivalent(parse(a), parse(b), timeout_s=timeout_s)
+    except SpotTimeoutError:
+        return False

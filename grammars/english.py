@@ -1,0 +1,311 @@
+"""STL in plain English: one realizer for reading a formula back and for writing
+varied training sentences.
+
+``explain(formula)`` is deterministic: the first phrasing of every construct, steps as
+the unit, propositions by name. ``realize(formula, rng, ...)`` draws a phrasing per
+construct, a time unit and a sentence layout, so one formula becomes many sentences.
+
+Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
+often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, then b",
+``!a U b`` "do not a until b". Everything else is read compositionally, and a binary
+subformula under another operator is read in its bracketing form ("both ... and ...",
+"either ... or ...") so that the scope survives in the sentence.
+
+A few phrasings per construct are *held out* (:data:`HELD_OUT`): the compositional
+test split uses them and training never does, to measure whether a translator
+generalizes to wordings it never saw.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from ara.errors import ConfigError
+from ara.grammars.ast import (
+    Always,
+    And,
+    Atom,
+    Const,
+    Eventually,
+    Formula,
+    Implies,
+    Interval,
+    Next,
+    Not,
+    Or,
+    Until,
+)
+
+# {a}, {b}: operands; {n}: an upper bound from 0; {lo}, {hi}: a window; {u}: the unit,
+# plural ("steps"); {s}: the unit, singular, only for step-like units ("step 5").
+PHRASES: dict[str, tuple[str, ...]] = {
+    "F": ("eventually {a}", "at some point {a}", "{a} at some point", "sometime {a}",
+          "{a} eventually", "make sure that eventually {a}", "sooner or later {a}",
+          "finally {a}", "at some moment in the future {a}"),
+    "F_n": ("within {n} {u}, {a}", "{a} within {n} {u}", "in the next {n} {u}, {a}",
+            "{a} within the next {n} {u}", "no later than {s} {n}, {a}",
+            "{a} in at most {n} {u}", "before {n} {u} have passed, {a}"),
+    "F_ab": ("at some point between {s} {lo} and {s} {hi}, {a}",
+             "{a} between {lo} and {hi} {u} from now", "within {lo} to {hi} {u}, {a}",
+             "{a} sometime from {s} {lo} to {s} {hi}",
+             "after {lo} {u} but no later than {hi} {u}, {a}",
+             "at some time in the window from {lo} to {hi} {u}, {a}"),
+    "G": ("always {a}", "{a} at all times", "at every step, {a}", "{a} forever",
+          "it is always the case that {a}", "globally {a}", "{a} all the time",
+          "constantly {a}"),
+    "G_n": ("for the first {n} {u}, {a}", "{a} for the next {n} {u}",
+            "during the first {n} {u}, {a}", "{a} at every step until {s} {n}",
+            "for {n} {u}, {a}", "{a} continuously for {n} {u}"),
+    "G_ab": ("from {s} {lo} to {s} {hi}, {a}", "{a} at every step between {lo} and {hi} {u}",
+             "throughout the window from {lo} to {hi} {u}, {a}",
+             "{a} all the time from {lo} to {hi} {u}",
+             "for each time instant in the next {lo} to {hi} {u}, {a}"),
+    "never": ("never {a}", "at no time {a}", "{a} must never happen", "must not ever {a}",
+              "always avoid {a}", "avoid {a} at all times", "it must never be the case that {a}",
+              "under no circumstances {a}"),
+    "never_n": ("never {a} in the first {n} {u}", "do not {a} during the first {n} {u}",
+                "avoid {a} for the next {n} {u}", "at no time in the next {n} {u}, {a}",
+                "{a} must not happen within {n} {u}"),
+    "never_ab": ("never {a} between {s} {lo} and {s} {hi}", "avoid {a} from {lo} to {hi} {u}",
+                 "at no time between {lo} and {hi} {u}, {a}"),
+    "FG": ("eventually {a} forever", "eventually always {a}", "from some point on, always {a}",
+           "sooner or later {a} for good", "{a} eventually holds forever",
+           "{a} from some point on, forever"),
+    "GF": ("{a} infinitely often", "{a} over and over again", "repeatedly {a}",
+           "always eventually {a}", "{a} again and again", "keep returning to {a} forever"),
+    "response": ("whenever {a}, eventually {b}", "every time {a}, {b} at some later point",
+                 "each time {a}, make sure that eventually {b}", "if ever {a}, then eventually {b}",
+                 "{a} is always followed by {b}", "any time {a}, sooner or later {b}"),
+    "response_n": ("whenever {a}, {b} within {n} {u}",
+                   "every time {a}, {b} within the next {n} {u}",
+                   "each time {a}, {b} in at most {n} {u}",
+                   "whenever {a}, within {n} {u} {b}"),
+    "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
+                  "at all times, if {a} then {b}", "always, if {a}, then {b}"),
+    "sequence": ("first {a}, then {b}", "{a} and after that {b}", "{a}, and afterwards {b}",
+                 "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}"),
+    "sequence3": ("first {a}, then {b}, then {c}", "{a}, then {b}, and finally {c}",
+                  "{a}, after that {b}, and after that {c}", "{a}, then {b}, then {c}",
+                  "in this order: {a}, {b}, {c}"),
+    "avoid_until": ("do not {a} until {b}", "{a} must not happen before {b}",
+                    "avoid {a} until {b}", "never {a} before {b}"),
+    "U": ("{a} until {b}", "keep {a} until {b}", "{a} holds until {b}",
+          "{a} must hold until {b} happens", "continue {a} until {b}"),
+    "U_n": ("{a} until {b}, which must happen within {n} {u}",
+            "keep {a} until {b} happens within {n} {u}", "{a} until {b} within the next {n} {u}"),
+    "U_ab": ("{a} until {b} happens between {s} {lo} and {s} {hi}",
+             "keep {a} until {b}, which happens within {lo} to {hi} {u}",
+             "{a} until, between {lo} and {hi} {u} from now, {b}"),
+    "->": ("if {a}, then {b}", "{a} implies {b}", "{b} if {a}", "in case {a}, {b}",
+           "provided that {a}, {b}", "{a} means that {b}"),
+    "<->": ("{a} if and only if {b}", "{a} exactly when {b}", "{a} is equivalent to {b}",
+            "{a} precisely when {b}", "{a} when and only when {b}"),
+    "&": ("{a} and {b}", "{a}, and also {b}", "{a} as well as {b}", "{a}, and {b}"),
+    "|": ("{a} or {b}", "{a}, or else {b}", "{a} or alternatively {b}", "{a}, or {b}"),
+    "!": ("not {a}", "it is not the case that {a}", "{a} does not hold"),
+    "!act": ("do not {a}", "don't {a}"),
+    # Bracketing forms: a binary subformula under another operator.
+    "&()": ("both {a} and {b}", "{a} and at the same time {b}"),
+    "|()": ("either {a} or {b}", "at least one of {a} or {b}"),
+    "->()": ("if {a} then {b}",),
+    "<->()": ("{a} exactly when {b}", "{a} if and only if {b}"),
+    "U()": ("{a} until {b}",),
+    "true": ("true",),
+    "false": ("false",),
+}
+
+#: Phrasings only the compositional test split uses; training never sees them.
+HELD_OUT: dict[str, frozenset[str]] = {
+    "F": frozenset({"at some moment in the future {a}"}),
+    "F_n": frozenset({"before {n} {u} have passed, {a}"}),
+    "F_ab": frozenset({"at some time in the window from {lo} to {hi} {u}, {a}"}),
+    "G": frozenset({"constantly {a}"}),
+    "G_n": frozenset({"{a} continuously for {n} {u}"}),
+    "G_ab": frozenset({"{a} all the time from {lo} to {hi} {u}"}),
+    "never": frozenset({"under no circumstances {a}"}),
+    "never_n": frozenset({"{a} must not happen within {n} {u}"}),
+    "FG": frozenset({"{a} from some point on, forever"}),
+    "GF": frozenset({"keep returning to {a} forever"}),
+    "response": frozenset({"any time {a}, sooner or later {b}"}),
+    "response_n": frozenset({"whenever {a}, within {n} {u} {b}"}),
+    "invariant": frozenset({"always, if {a}, then {b}"}),
+    "sequence": frozenset({"{a}, followed by {b}"}),
+    "sequence3": frozenset({"in this order: {a}, {b}, {c}"}),
+    "U": frozenset({"continue {a} until {b}"}),
+    "<->": frozenset({"{a} when and only when {b}"}),
+    "|": frozenset({"{a}, or {b}"}),
+}
+
+#: Time units: (plural, singular or None where "step 5" would not read).
+UNITS: tuple[tuple[str, str | None], ...] = (
+    ("steps", "step"), ("time steps", "time step"), ("time units", None), ("seconds", None),
+)
+MODES = ("all", "train", "test")
+
+
+@dataclass(frozen=True)
+class Realizer:
+    """How one sentence is worded.
+
+    Args:
+        rng: Draws the phrasings; ``None`` takes the first phrasing everywhere.
+        mode: ``train`` never uses held-out phrasings, ``test`` prefers them where a
+            construct has one, ``all`` draws from every phrasing.
+        unit: Index into :data:`UNITS`.
+        say_atom: How a proposition is said (``prop_1`` -> ``(prop_1)``, or
+            ``go_to_kitchen`` -> ``go to the kitchen``).
+        is_action: Whether a proposition reads as an imperative ("do not go ...").
+    """
+
+    rng: random.Random | None = None
+    mode: str = "all"
+    unit: int = 0
+    say_atom: Callable[[str], str] = field(default=lambda name: name)
+    is_action: Callable[[str], bool] = field(default=lambda name: False)
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ConfigError(f"realizer mode must be one of {MODES}, got {self.mode!r}")
+        if not 0 <= self.unit < len(UNITS):
+            raise ConfigError(f"unit must index UNITS (0..{len(UNITS) - 1}), got {self.unit}")
+
+    def pick(self, construct: str, used: list[str] | None = None, first: int = 0,
+             **slots: object) -> str:
+        """One phrasing of ``construct`` with its slots filled; without an ``rng``, the
+        one at index ``first``."""
+        plural, singular = UNITS[self.unit]
+        options = [p for p in PHRASES[construct] if singular is not None or "{s}" not in p]
+        held = HELD_OUT.get(construct, frozenset())
+        if self.mode == "train":
+            options = [p for p in options if p not in held] or options
+        elif self.mode == "test" and self.rng is not None:
+            preferred = [p for p in options if p in held]
+            if preferred and self.rng.random() < 0.7:
+                options = preferred
+        phrase = PHRASES[construct][first] if self.rng is None else self.rng.choice(options)
+        if used is not None:
+            used.append(f"{construct}:{PHRASES[construct].index(phrase)}")
+        return phrase.format(u=plural, s=singular, **slots)
+
+
+def explain(formula: Formula) -> str:
+    """A deterministic plain-English reading of ``formula``.
+
+    >>> explain(parse("G(a -> F[0,5](b))"))
+    'whenever a, b within 5 steps'
+    """
+    return _say(formula, Realizer(say_atom=lambda name: name), None, embedded=False)
+
+
+def realize(formula: Formula, realizer: Realizer, used: list[str] | None = None) -> str:
+    """One wording of ``formula``; ``used`` collects the ids of the phrasings used."""
+    text = _say(formula, realizer, used, embedded=False)
+    rng = realizer.rng
+    if rng is not None:
+        # "Prop_1" would be another proposition: never capitalize a name
+        if rng.random() < 0.5 and "_" not in text.split(" ", 1)[0]:
+            text = text[0].upper() + text[1:]
+        if rng.random() < 0.4:
+            text += "."
+    return text
+
+
+def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool) -> str:
+    idiom = _idiom(f, r, used)
+    if idiom is not None:
+        return idiom
+
+    def sub(g: Formula) -> str:
+        return _say(g, r, used, embedded=True)
+
+    if isinstance(f, Atom):
+        return r.say_atom(f.name)
+    if isinstance(f, Const):
+        return r.pick("true" if f.value else "false", used)
+    if isinstance(f, Not):
+        act = isinstance(f.arg, Atom) and r.is_action(f.arg.name)
+        return r.pick("!act" if act else "!", used, a=sub(f.arg))
+    if isinstance(f, Next):
+        return f"at the next step {sub(f.arg)}"
+    if isinstance(f, (Eventually, Always)):
+        op = "F" if isinstance(f, Eventually) else "G"
+        return _timed(op, f.interval, r, used, a=sub(f.arg))
+    if isinstance(f, (And, Or)):
+        op = "&" if isinstance(f, And) else "|"
+        key = op + "()" if embedded else op
+        text = sub(f.args[0])
+        for arg in f.args[1:]:
+            # A comma keeps "first a, then b, and never c" from reading as one sequence.
+            comma = 3 if not embedded and " " in text else 0
+            text = r.pick(key, used, first=comma, a=text, b=sub(arg))
+        return text
+    if isinstance(f, Until):
+        if f.interval is None:
+            return r.pick("U()" if embedded else "U", used, a=sub(f.lhs), b=sub(f.rhs))
+        return _timed("U", f.interval, r, used, a=sub(f.lhs), b=sub(f.rhs))
+    op = "->" if isinstance(f, Implies) else "<->"
+    return r.pick(op + "()" if embedded else op, used, a=sub(f.lhs), b=sub(f.rhs))
+
+
+def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | None,
+           **slots: str) -> str:
+    """An operator with its interval: untimed, ``[0,n]`` or a window ``[lo,hi]``."""
+    if interval is None:
+        return r.pick(op, used, **slots)
+    if interval.hi is None:  # [lo,inf]: no construct of its own; say the lower bound
+        return r.pick(op, used, **slots) + f" (from step {interval.lo} on)"
+    if interval.lo == 0:
+        return r.pick(op + "_n", used, n=interval.hi, **slots)
+    return r.pick(op + "_ab", used, lo=interval.lo, hi=interval.hi, **slots)
+
+
+def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
+    """The idiomatic reading of a common pattern, or ``None``."""
+
+    def sub(g: Formula) -> str:
+        return _say(g, r, used, embedded=True)
+
+    if isinstance(f, Always) and isinstance(f.arg, Not) and (
+            f.interval is None or f.interval.hi is not None):
+        return _timed("never", f.interval, r, used, a=sub(f.arg.arg))
+    if isinstance(f, Eventually) and f.interval is None and isinstance(f.arg, Always) \
+            and f.arg.interval is None:
+        return r.pick("FG", used, a=sub(f.arg.arg))
+    if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Eventually) \
+            and f.arg.interval is None:
+        return r.pick("GF", used, a=sub(f.arg.arg))
+    if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies):
+        lhs, rhs = f.arg.lhs, f.arg.rhs
+        if isinstance(rhs, Eventually) and (rhs.interval is None or
+                                             (rhs.interval.lo == 0 and rhs.interval.hi)):
+            if rhs.interval is None:
+                return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
+            return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
+        return r.pick("invariant", used, a=sub(lhs), b=sub(rhs))
+    steps = _sequence(f)
+    if steps is not None and len(steps) == 2:
+        return r.pick("sequence", used, a=sub(steps[0]), b=sub(steps[1]))
+    if steps is not None:
+        # Three or more steps: the last two are one step of the three-step phrasing.
+        last = r.pick("sequence", used, a=sub(steps[-2]), b=sub(steps[-1])) \
+            if len(steps) > 3 else sub(steps[-1])
+        middle = ", then ".join(sub(g) for g in steps[1:-2]) if len(steps) > 3 \
+            else sub(steps[1])
+        return r.pick("sequence3", used, a=sub(steps[0]), b=middle, c=last)
+    if isinstance(f, Until) and f.interval is None and isinstance(f.lhs, Not):
+        return r.pick("avoid_until", used, a=sub(f.lhs.arg), b=sub(f.rhs))
+    return None
+
+
+def _sequence(f: Formula) -> list[Formula] | None:
+    """``F(a & F(b & F(c)))`` as ``[a, b, c]``; ``None`` if ``f`` is no such chain."""
+    if not (isinstance(f, Eventually) and f.interval is None and isinstance(f.arg, And)
+            and len(f.arg.args) == 2):
+        return None
+    head, tail = f.arg.args
+    if not (isinstance(tail, Eventually) and tail.interval is None):
+        return None
+    rest = _sequence(tail)
+    return [head] + (rest if rest is not None else [tail.arg])

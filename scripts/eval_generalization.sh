@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Translation accuracy on sentences a model never trained on, next to the paper split.
+#
+#   scripts/eval_generalization.sh MODEL NAME [SET ...]
+#
+# MODEL is an `ara --model` value (finetuned, finetuned-paper, default, lora:FILE.gguf);
+# NAME names the results folder docs/results/generalization/NAME/<set>-<form>/. SETs
+# (default: all): handwritten (the hand-written suite, all 164), compositional (held-out
+# shapes and phrasings, 50 lifted + 50 grounded), timed (NL2TL's lifted dev file, 100),
+# paper and disjoint (100 lifted each); $LIMIT overrides the sampled sizes. Variants: $VARIANTS (default none,C,F+C; C,F+C on
+# paper and disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
+# Spot's limit 5 s a pair (undecided counts as wrong). Each run resumes from its samples.
+# `scripts/generalization_table.py` prints the table from what is there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+model=${1:?usage: eval_generalization.sh MODEL NAME [SET ...]}
+name=${2:?usage: eval_generalization.sh MODEL NAME [SET ...]}
+shift 2
+sets=${*:-handwritten compositional timed paper disjoint}
+variants=${VARIANTS:-none,C,F+C}
+out=docs/results/generalization/$name
+
+run() {  # SPLIT FORM LIMIT [VARIANTS]
+  .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \
+    --variants "${4:-$variants}" --shots 5 --reruns 1 --seed 0 --spot-timeout 5 --resume \
+    --no-progress --out "$out/$1-$2" > /dev/null
+  echo "done: $name $1 $2"
+}
+
+for set in $sets; do
+  case $set in
+  handwritten) run handwritten lifted 200; run handwritten grounded 200 ;;
+  compositional) run compositional lifted "${LIMIT:-50}"; run compositional grounded "${LIMIT:-50}" ;;
+  timed) run timed lifted "${LIMIT:-100}" ;;
+  paper|disjoint) run "$set" lifted "${LIMIT:-100}" "${VARIANTS:-C,F+C}" ;;
+  *) echo "unknown set $set (handwritten compositional timed paper disjoint)" >&2; exit 2 ;;
+  esac
+done

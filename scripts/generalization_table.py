@@ -1,0 +1,114 @@
+"""The generalization table: each model on each evaluation set, from the runs that
+``scripts/eval_generalization.sh`` wrote.
+
+    .venv/bin/python scripts/generalization_table.py [--results docs/results/generalization]
+
+A cell is accuracy / validity in % over all pairs of the run (invalid and undecided
+answers count as wrong). ``unseen`` is the accuracy on the pairs whose sentence does
+not occur in that model's own training data, the figure that says what a user's new
+sentence can expect; the paper split's lifted test side is almost all seen. Writes
+``summary.json`` beside the runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import statistics
+from collections import defaultdict
+from datetime import date
+from pathlib import Path
+
+#: Results folder -> (label, the split the model trained on or None).
+MODELS = {
+    "base-270m": ("base", None),
+    "paper-adapter-270m": ("paper adapter (old)", "paper"),
+    "compositional-adapter-270m": ("compositional adapter (new)", "compositional"),
+}
+SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
+        ("compositional", "lifted"), ("compositional", "grounded"),
+        ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
+VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]
+
+
+def training_sentences(split: str | None) -> set[str]:
+    if split is None:
+        return set()
+    from ara.data import load_or_prepare
+
+    return {r.nl for r in load_or_prepare(split, 0).records("train")}
+
+
+def cell(samples: list[dict], seen: set[str]) -> dict:
+    unseen = [s for s in samples if s["nl"] not in seen]
+    return {
+        "pairs": len(samples),
+        "accuracy": 100 * statistics.fmean(bool(s["equivalent"]) for s in samples),
+        "validity": 100 * statistics.fmean(bool(s["valid"]) for s in samples),
+        "unseen_pairs": len(unseen),
+        "unseen_accuracy": (100 * statistics.fmean(bool(s["equivalent"]) for s in unseen)
+                            if unseen else None),
+        "median_ms": statistics.median(s["ms"] for s in samples),
+    }
+
+
+def collect(results: Path) -> dict:
+    table: dict = defaultdict(dict)
+    for folder, (_, trained_on) in MODELS.items():
+        seen = training_sentences(trained_on)
+        for split, form in SETS:
+            path = results / folder / f"{split}-{form}" / "samples.jsonl"
+            if not path.exists():
+                continue
+            by_variant = defaultdict(list)
+            for line in path.read_text().splitlines():
+                s = json.loads(line)
+                by_variant[(s["variant"], s["shots"])].append(s)
+            for key, samples in by_variant.items():
+                table[(split, form, *key)][folder] = cell(samples, seen)
+    return table
+
+
+def markdown(table: dict) -> str:
+    names = [m for m in MODELS if any(m in row for row in table.values())]
+    head = "| set | form | variant | pairs | " + " | ".join(MODELS[m][0] for m in names) + " |"
+    lines = [head, "|---|---|---|---:|" + "---:|" * len(names)]
+    for split, form in SETS:
+        for variant, shots in VARIANTS:
+            row = table.get((split, form, variant, shots))
+            if not row:
+                continue
+            pairs = next(iter(row.values()))["pairs"]
+            cells = []
+            for m in names:
+                c = row.get(m)
+                if c is None:
+                    cells.append("-")
+                    continue
+                text = f"{c['accuracy']:.1f} / {c['validity']:.0f}"
+                if c["unseen_pairs"] < c["pairs"] and c["unseen_accuracy"] is not None:
+                    text += f" (unseen {c['unseen_accuracy']:.1f}, n={c['unseen_pairs']})"
+                cells.append(text)
+            label = variant if not shots else f"{variant} {shots}-shot"
+            lines.append(f"| {split} | {form} | {label} | {pairs} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--results", type=Path, default=Path("docs/results/generalization"))
+    args = parser.parse_args()
+    table = collect(args.results)
+    print(markdown(table))
+    print("\nCells: accuracy / validity in %; (unseen ...): accuracy on the pairs whose "
+          "sentence is not in that model's training data.")
+    summary = {"date": date.today().isoformat(), "machine": platform.platform(),
+               "cells": [{"set": k[0], "form": k[1], "variant": k[2], "shots": k[3],
+                          "model": m, **c} for k, row in sorted(table.items())
+                         for m, c in row.items()]}
+    (args.results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,56 @@
+"""Semantic self-consistency: answers vote by meaning, and the greedy one breaks ties."""
+
+from __future__ import annotations
+
+import pytest
+
+from ara.errors import ConfigError
+from ara.eval.backends.base import BackendError, Sampling
+from ara.eval.consistency import _group, translate_consistent
+from ara.eval.translator import Translator
+
+from conftest import needs_llama
+
+
+def test_answers_group_by_meaning_not_by_text():
+    """Tests that Spot-equivalent spellings share a group and unparsed answers stand alone."""
+    answers = ("F(a) | F(b)", "G(a)", "F(a | b)", None, "G(a)")
+    assert _group(answers, timeout_s=10) == [(0, 2), (1, 4), (3,)]
+
+
+def test_sampling_settings_are_checked():
+    """Tests that a zero temperature (greedy in disguise) is refused with the fix."""
+    with pytest.raises(BackendError, match="pass no Sampling"):
+        Sampling(temperature=0)
+
+
+@needs_llama
+def test_sampled_answers_are_valid_seeded_and_varied(llama_backend):
+    """Tests that sampling under the grammar keeps every answer valid, that a seed fixes
+    the answer, and that seeds give different answers."""
+    t = Translator(llama_backend)
+    aps = ("prop_1", "prop_2")
+    nl = "whenever (prop_1), eventually (prop_2)"
+    draws = [t.translate(nl, aps, sampling=Sampling(1.0, seed)).stl for seed in range(6)]
+    assert all(d is not None for d in draws)
+    assert t.translate(nl, aps, sampling=Sampling(1.0, 3)).stl == draws[3]
+    assert len(set(draws)) > 1
+
+
+@needs_llama
+def test_one_sample_is_greedy_and_the_vote_is_reproducible(llama_backend):
+    """Tests that samples=1 is the greedy answer, and that the winner belongs to the
+    largest group, ties going to the greedy answer."""
+    t = Translator(llama_backend)
+    aps = ("prop_1",)
+    nl = "always eventually (prop_1)"
+    greedy = t.translate(nl, aps).stl
+    assert translate_consistent(t, nl, aps, samples=1).result.stl == greedy
+    vote = translate_consistent(t, nl, aps, samples=4, temperature=1.0, seed=7)
+    again = translate_consistent(t, nl, aps, samples=4, temperature=1.0, seed=7)
+    assert (again.answers, again.groups) == (vote.answers, vote.groups)
+    assert sorted(i for g in vote.groups for i in g) == [0, 1, 2, 3]
+    assert vote.result.stl == vote.answers[vote.groups[0][0]]
+    assert len(vote.groups[0]) == max(len(g) for g in vote.groups)
+    with pytest.raises(ConfigError, match="samples must be >= 1"):
+        translate_consistent(t, nl, aps, samples=0)
