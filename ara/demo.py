@@ -64,9 +64,9 @@ def demo_cmd(
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
     if shots is None:
-        from ara.eval.models import is_finetuned
+        from ara.eval.models import default_shots
 
-        shots = 0 if is_finetuned(model) else 5
+        shots = default_shots(model)
     translator = _translate_some(model, n, seed, shots)
     _help_round(translator)
 

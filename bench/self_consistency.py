@@ -24,7 +24,7 @@ from tqdm import tqdm
 from ara.data import load_or_prepare
 from ara.eval.consistency import translate_consistent
 from ara.eval.harness import judge
-from ara.eval.models import is_finetuned, make_backend
+from ara.eval.models import default_shots, make_backend
 from ara.eval.prompt import sample_shots
 from ara.eval.translator import Translator
 
@@ -39,7 +39,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("docs/results/self-consistency.json"))
     args = parser.parse_args()
     translator = Translator(make_backend(args.model))
-    k = 0 if is_finetuned(args.model) else 5
+    k = default_shots(args.model)
     rows = []
     for form in ("lifted", "grounded"):
         pool = load_or_prepare("compositional", 0).records("train", form)

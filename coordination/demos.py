@@ -91,10 +91,11 @@ def _pallet(world: GridWorld, translator, echo) -> dict:
     drop = world.nearest_free_neighbour(site)
     template = template_help_spec(site, drop, ())
     for o in rnd.offers:
-        same = bool(o.stl) and equivalent(parse(o.stl), template, timeout_s=10)
-        echo(f"[forklift {o.helper}] STL: {o.stl or '-'}"
-             + (f"  (pick-before-place template: {'equivalent' if same else 'differs'})"
-                if translator is not None else ""))
+        verdict = ""
+        if translator is not None:  # without one, every helper plans the template itself
+            same = bool(o.stl) and equivalent(parse(o.stl), template, timeout_s=10)
+            verdict = f"  (pick-before-place template: {'equivalent' if same else 'differs'})"
+        echo(f"[forklift {o.helper}] STL: {o.stl or '-'}{verdict}")
         echo(f"[forklift {o.helper}] {o.text}")
     for d in rnd.decisions:
         echo(f"[requester -> forklift {d.helper}] {d.text}")

@@ -5,19 +5,17 @@ confused with. Test only: no training mixture includes it.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
 
-from ara.data.normalize import Record, _UidMaker
+from ara.data.normalize import Record, _UidMaker, form_of
 from ara.errors import ConfigError
 from ara.grammars import atoms, parse, to_text
 
 SUITE = Path(__file__).parent / "handwritten" / "suite.yaml"
 SOURCE = "handwritten"
-_LIFTED = re.compile(r"prop_\d+")
 
 
 @dataclass(frozen=True)
@@ -42,7 +40,7 @@ class SuiteEntry:
 
     @property
     def form(self) -> str:
-        return "lifted" if all(_LIFTED.fullmatch(a) for a in self.aps) else "grounded"
+        return form_of(self.aps)
 
 
 def load_suite(path: Path = SUITE) -> list[SuiteEntry]:

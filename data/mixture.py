@@ -21,7 +21,13 @@ import random
 from dataclasses import asdict
 from pathlib import Path
 
-from ara.data.normalize import Record, RejectedRow, normalize_navi, normalize_timed
+from ara.data.normalize import (
+    Record,
+    RejectedRow,
+    normalize_navi,
+    normalize_timed,
+    read_jsonl,
+)
 from ara.data.splits import paper_split
 from ara.data.synthetic import (
     SYNTHETIC_VERSION,
@@ -35,10 +41,6 @@ from ara.provenance import sha256_file
 SYNTHETIC_TRAIN_ROWS = 4000
 SYNTHETIC_TEST_ROWS = 400
 NAVI_GROUNDED = 1500
-
-
-def _read_jsonl(path: Path) -> list[dict]:
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
 def _dedup(records: list[Record]) -> list[Record]:
@@ -59,14 +61,14 @@ def compositional_split(raw_dir: Path, seed: int
     Returns:
         ``(parts, rejected, sources)`` as :func:`ara.data.store.build_split` does.
     """
-    navi_rows = _read_jsonl(raw_dir / "navi.jsonl")
+    navi_rows = read_jsonl(raw_dir / "navi.jsonl")
     navi, rejected = normalize_navi(navi_rows)
     navi_train = paper_split(navi, len(navi_rows), seed)["train"]
     lifted = _dedup([r for r in navi_train if r.form == "lifted"])
     grounded = _dedup([r for r in navi_train if r.form == "grounded"])
     grounded = random.Random(f"{seed}:navi-grounded").sample(grounded,
                                                              min(NAVI_GROUNDED, len(grounded)))
-    timed, rejected_timed = normalize_timed(_read_jsonl(raw_dir / "lifted_stl_train.jsonl"),
+    timed, rejected_timed = normalize_timed(read_jsonl(raw_dir / "lifted_stl_train.jsonl"),
                                             "nl2tl_timed_train")
     settings = SynthSettings()
     # A held-out shape stays out of training whatever the source wrote it.

@@ -12,6 +12,7 @@ import re
 from collections import Counter
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 from ara.errors import AraError
 from ara.grammars import Formula, atoms, parse, to_text
@@ -27,6 +28,7 @@ _OPERATOR_WORDS = {
     "and": "&", "or": "|", "imply": "->", "equal": "<->",
 }
 _POS_TAG = re.compile(r"_(v|n|a|adj|adv)$")
+_LIFTED_NAME = re.compile(r"prop_\d+")
 
 
 @dataclass(frozen=True)
@@ -81,6 +83,16 @@ class RejectedRow:
 
 class _RowError(AraError, ValueError):
     pass
+
+
+def read_jsonl(path: Path) -> list[dict]:
+    """The rows of a raw JSON-lines file (blank lines skipped)."""
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def form_of(aps: Iterable[str]) -> str:
+    """``lifted`` when every proposition is named ``prop_N``, else ``grounded``."""
+    return "lifted" if all(_LIFTED_NAME.fullmatch(a) for a in aps) else "grounded"
 
 
 def lifted_tokens_to_text(tokens: Iterable[str]) -> str:

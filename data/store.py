@@ -26,6 +26,7 @@ from ara.data.normalize import (
     RejectedRow,
     normalize_navi,
     normalize_timed,
+    read_jsonl,
 )
 from ara.data.splits import disjoint_split, given_split, overlap_stats, paper_split
 from ara.errors import ConfigError, DataVersionError, did_you_mean
@@ -75,10 +76,6 @@ class PreparedSplit:
         return [r for r in records if form is None or r.form == form]
 
 
-def _read_jsonl(path: Path) -> list[dict]:
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
-
-
 def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[RejectedRow], dict]:
     """Normalize the raw files and split them, without writing anything.
 
@@ -96,12 +93,12 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
                 {SUITE.name: sha256_file(SUITE)})
     if split == "timed":
         files = ["lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"]
-        train, rej_train = normalize_timed(_read_jsonl(RAW_DIR / files[0]), "nl2tl_timed_train")
-        test, rej_test = normalize_timed(_read_jsonl(RAW_DIR / files[1]), "nl2tl_timed_dev")
+        train, rej_train = normalize_timed(read_jsonl(RAW_DIR / files[0]), "nl2tl_timed_train")
+        test, rej_test = normalize_timed(read_jsonl(RAW_DIR / files[1]), "nl2tl_timed_dev")
         parts, rejected = given_split(train, test), rej_train + rej_test
     else:
         files = ["navi.jsonl"]
-        rows = _read_jsonl(RAW_DIR / files[0])
+        rows = read_jsonl(RAW_DIR / files[0])
         records, rejected = normalize_navi(rows)
         parts = (paper_split(records, len(rows), seed) if split == "paper"
                  else disjoint_split(records, seed))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import random
-import re
 import signal
 from pathlib import Path
 
@@ -50,7 +49,8 @@ def translate_cmd(
 ) -> None:
     """Translate one instruction into STL over the given propositions."""
     from ara.data import load_or_prepare
-    from ara.eval.models import is_finetuned, make_backend
+    from ara.data.normalize import form_of
+    from ara.eval.models import default_shots, make_backend
     from ara.eval.prompt import sample_shots
     from ara.eval.translator import Translator, TranslatorConfig, check_request
 
@@ -58,20 +58,19 @@ def translate_cmd(
         names = split_list(aps)
         config = TranslatorConfig(intervals=intervals, max_bound=max_bound)
         check_request(nl, names, config)
-        k = shots if shots is not None else (0 if is_finetuned(model) else 5)
-        form = "lifted" if all(re.fullmatch(r"prop_\d+", a) for a in names) else "grounded"
-        examples = (sample_shots(load_or_prepare("compositional").records("train", form), k,
-                                 random.Random(seed)) if k else [])
-        translator = Translator(make_backend(model), config)
-        vote = None
         if samples > 1 and no_constraint:
             raise ConfigError("--samples decodes under the grammar (every sample valid); "
                               "drop --no-constraint")
+        k = shots if shots is not None else default_shots(model)
+        pool = load_or_prepare("compositional").records("train", form_of(names))
+        examples = sample_shots(pool, k, random.Random(seed)) if k else []
+        translator = Translator(make_backend(model), config)
+        vote = None
         if samples > 1:
             from ara.eval.consistency import translate_consistent
 
             vote = translate_consistent(translator, nl, names, examples, samples, temperature,
-                                        seed)
+                                        seed, grammar_in_prompt=grammar_in_prompt)
             result = vote.result
         else:
             result = translator.translate(nl, names, examples, grammar_in_prompt,

@@ -54,7 +54,7 @@ class Vote:
 def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
                          shots: Sequence[Shot] = (), samples: int = 5,
                          temperature: float = 0.7, seed: int = 0,
-                         timeout_s: float = 10.0) -> Vote:
+                         timeout_s: float = 10.0, grammar_in_prompt: bool = False) -> Vote:
     """Translate ``nl`` ``samples`` times under the grammar and keep the majority meaning.
 
     Args:
@@ -64,14 +64,16 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
         temperature: Sampling temperature, > 0.
         seed: Answer ``i`` is drawn with seed ``seed + i``.
         timeout_s: Spot's limit per comparison; an undecided pair counts as different.
+        grammar_in_prompt: Show the grammar in every prompt (variant P).
     """
     if samples < 1:
         raise ConfigError(f"samples must be >= 1, got {samples}")
     start = time.perf_counter()
-    results = [translator.translate(nl, aps, shots)]
+    results = [translator.translate(nl, aps, shots, grammar_in_prompt)]
     for i in range(1, samples):
         sampling = Sampling(temperature=temperature, seed=seed + i)
-        results.append(translator.translate(nl, aps, shots, sampling=sampling))
+        results.append(translator.translate(nl, aps, shots, grammar_in_prompt,
+                                            sampling=sampling))
     groups = _group([r.stl for r in results], timeout_s)
     ranked = sorted(groups, key=lambda g: (-len(g), g[0]))
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)

@@ -25,9 +25,10 @@ PAPER_LORA = SHIPPED / "gemma3-270m-nl2tl-paper-lora.gguf"
 SHIPPED_ADAPTERS = {"finetuned": FINETUNED_LORA, "finetuned-paper": PAPER_LORA}
 
 
-def is_finetuned(model: str) -> bool:
-    """Whether ``model`` names a fine-tuned adapter (these translate zero-shot)."""
-    return model in SHIPPED_ADAPTERS or model.startswith("lora:")
+def default_shots(model: str) -> int:
+    """Worked examples a prompt shows by default: none for a fine-tuned adapter, which
+    learned the task, and 5 for any other model."""
+    return 0 if model in SHIPPED_ADAPTERS or model.startswith("lora:") else 5
 
 
 def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",

@@ -193,8 +193,8 @@ class Translator:
             completion = self.backend.complete(prompt, None, self.config.max_tokens, STOP,
                                                sampling)
         raw = completion.text
-        if constrained and raw.endswith(STOP):  # the grammar's own end, as STOP is freely
-            raw = raw[: -len(STOP)]
+        if constrained and raw.endswith(STOP):  # the grammar's end marker, as free decoding
+            raw = raw[: -len(STOP)]              # strips its stop string
         stl, error = None, None
         try:
             stl = to_text(parse(raw))

@@ -109,11 +109,7 @@ class Grammar:
         Decoders use it for the space a model writes after ``"STL:"``, so that the
         answer tokenizes as in training; the caller strips the prefix again.
         """
-        name = self.root + "_prefixed"
-        while name in self.by_name:
-            name += "_"
-        rules = (Rule(name, ((Lit(text), Ref(self.root)),)), *self.rules)
-        return Grammar(rules, root=name)
+        return self._wrapped("prefixed", (Lit(text), Ref(self.root)))
 
     def with_suffix(self, text: str) -> Grammar:
         """The language ``w + text`` for each string ``w`` of this one.
@@ -123,11 +119,14 @@ class Grammar:
         operators that may continue a complete formula (``a -> ...``) and the end of
         text, which it was never taught to emit there; the caller strips the suffix.
         """
-        name = self.root + "_suffixed"
+        return self._wrapped("suffixed", (Ref(self.root), Lit(text)))
+
+    def _wrapped(self, tag: str, items: tuple) -> Grammar:
+        """This grammar under a new start rule ``items``, named after the old root."""
+        name = f"{self.root}_{tag}"
         while name in self.by_name:
             name += "_"
-        rules = (Rule(name, ((Ref(self.root), Lit(text)),)), *self.rules)
-        return Grammar(rules, root=name)
+        return Grammar((Rule(name, (items,)), *self.rules), root=name)
 
     @_memoized
     def to_gbnf(self) -> str:

@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from ara.data import load_or_prepare
 from ara.eval.harness import judge
-from ara.eval.models import is_finetuned, make_backend
+from ara.eval.models import default_shots, make_backend
 from ara.eval.prompt import sample_shots
 from ara.eval.translator import Translator
 from ara.grammars import parse
@@ -43,7 +43,7 @@ def main() -> None:
             sources[f"{split}-{form}"] = random.Random(0).sample(
                 records, min(args.limit, len(records)))
     translator = Translator(make_backend(args.model))
-    k = 0 if is_finetuned(args.model) else 5
+    k = default_shots(args.model)
     pool = load_or_prepare("compositional", 0).records("train", "grounded")
     shots = sample_shots(pool, k, random.Random(0)) if k else []
     rows = []
