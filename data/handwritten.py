@@ -10,7 +10,7 @@ from pathlib import Path
 
 import yaml
 
-from ara.data.normalize import Record, _UidMaker, form_of
+from ara.data.normalize import Record, UidMaker, form_of
 from ara.errors import ConfigError
 from ara.grammars import atoms, parse, to_text
 
@@ -66,6 +66,6 @@ def load_suite(path: Path = SUITE) -> list[SuiteEntry]:
 
 def suite_records(path: Path = SUITE) -> list[Record]:
     """The suite as test records (row = position in the file)."""
-    uid = _UidMaker()
+    uid = UidMaker()
     return [Record(uid(SOURCE, e.form, e.nl, e.stl), e.nl, e.stl, e.aps, SOURCE, e.form, i)
             for i, e in enumerate(load_suite(path))]

@@ -8,7 +8,13 @@ Train, by source (each deduplicated, so no sentence is learned by repetition):
   has only 522 distinct ones), grounded ones sampled;
 * ``nl2tl_timed_train``: NL2TL's lifted timed training file (``lifted_stl_dev`` stays
   out: it is the timed evaluation set);
-* ``synthetic``: :func:`ara.data.synthetic.synthetic_records`, train side.
+* ``synthetic``: :func:`ara.data.synthetic.synthetic_records`, train side;
+* ``help_request``: :func:`ara.data.help_requests.help_request_records`, a stuck
+  robot's request answered with the coordination template's spec (the wordings the
+  coordination bench measures are never among them).
+
+NL2TL's timed file is labelled by :func:`ara.data.normalize.lifted_from_grounded`,
+which makes it agree with navi on every sentence they share.
 
 Test: synthetic rows whose shapes are held out, worded with held-out phrasings where
 a construct has them. Records of any source with a held-out shape stay out of train.
@@ -21,8 +27,10 @@ import random
 from dataclasses import asdict
 from pathlib import Path
 
+from ara.data.help_requests import HELP_REQUEST_ROWS, help_request_records
 from ara.data.normalize import (
     Record,
+    TIMED_LABELS_VERSION,
     RejectedRow,
     normalize_navi,
     normalize_timed,
@@ -74,13 +82,16 @@ def compositional_split(raw_dir: Path, seed: int
     # A held-out shape stays out of training whatever the source wrote it.
     nl2tl = [r for r in lifted + sorted(grounded, key=lambda r: r.row) + _dedup(timed)
              if not is_held_out(r.formula, settings)]
-    train = nl2tl + synthetic_records(SYNTHETIC_TRAIN_ROWS, seed, held_out=False,
-                                      settings=settings)
+    train = (nl2tl + synthetic_records(SYNTHETIC_TRAIN_ROWS, seed, held_out=False,
+                                       settings=settings)
+             + help_request_records(HELP_REQUEST_ROWS, seed))
     test = synthetic_records(SYNTHETIC_TEST_ROWS, seed, held_out=True, settings=settings)
     sources = {name: sha256_file(raw_dir / name)
                for name in ("navi.jsonl", "lifted_stl_train.jsonl")}
+    sources["timed_labels"] = TIMED_LABELS_VERSION
     sources["synthetic"] = json.dumps({"version": SYNTHETIC_VERSION, **asdict(settings),
                                        "train_rows": SYNTHETIC_TRAIN_ROWS,
                                        "test_rows": SYNTHETIC_TEST_ROWS,
-                                       "navi_grounded": NAVI_GROUNDED}, sort_keys=True)
+                                       "navi_grounded": NAVI_GROUNDED,
+                                       "help_requests": HELP_REQUEST_ROWS}, sort_keys=True)
     return {"train": train, "test": test}, rejected + rejected_timed, sources

@@ -20,6 +20,9 @@ from ara.grammars.ast import ASTError, rename_atoms
 
 #: Bumped whenever the records produced from the same raw rows change.
 NORMALIZER_VERSION = "1.0.0"
+#: The timed files' label rule (:func:`lifted_from_grounded`); part of the version of
+#: every split made from them, so navi-only splits keep theirs.
+TIMED_LABELS_VERSION = "grounded-structure-1"
 
 # NL2TL writes operators as words in the lifted timed data and as "-" for negation in
 # navi; mapping tokens keeps one parser for everything.
@@ -28,7 +31,12 @@ _OPERATOR_WORDS = {
     "and": "&", "or": "|", "imply": "->", "equal": "<->",
 }
 _POS_TAG = re.compile(r"_(v|n|a|adj|adv)$")
+# The operator tokens of navi-style grounded formulas (``G ( - ( go_to_v house_n ) )``);
+# every other token is part of a predicate name.
+_NAVI_OPERATORS = {"G": "G", "F": "F", "U": "U", "-": "!", "&": "&", "|": "|",
+                   "->": "->", "(": "(", ")": ")"}
 _LIFTED_NAME = re.compile(r"prop_\d+")
+_NUMBER = re.compile(r"-?\d+(\.\d+)?")
 
 
 @dataclass(frozen=True)
@@ -114,7 +122,7 @@ def grounded_name(predicate_tokens: list[str]) -> str:
     return re.sub(r"[^A-Za-z0-9_]", "_", name)
 
 
-class _UidMaker:
+class UidMaker:
     """Content-hash uids, disambiguating exact repeats by their order of appearance."""
 
     def __init__(self) -> None:
@@ -129,7 +137,9 @@ class _UidMaker:
         return hashlib.sha256(content.encode()).hexdigest()[:16]
 
 
-def _record(uid: _UidMaker, source: str, form: str, row: int, nl: str, f: Formula) -> Record:
+def make_record(uid: UidMaker, source: str, form: str, row: int, nl: str,
+                f: Formula) -> Record:
+    """A record of ``f`` in canonical text, its uid from ``uid``."""
     stl = to_text(f)
     return Record(uid(source, form, nl, stl), nl, stl, tuple(sorted(atoms(f))), source, form, row)
 
@@ -140,7 +150,7 @@ def normalize_navi(rows: list[dict]) -> tuple[list[Record], list[RejectedRow]]:
     The lifted formula is the label; the grounded one renames each ``prop_i`` to the
     predicate that the row's ``propositions`` gives it.
     """
-    uid = _UidMaker()
+    uid = UidMaker()
     records: list[Record] = []
     rejected: list[RejectedRow] = []
     for i, row in enumerate(rows):
@@ -155,24 +165,64 @@ def normalize_navi(rows: list[dict]) -> tuple[list[Record], list[RejectedRow]]:
         except (ValueError, ASTError, KeyError, IndexError) as err:
             rejected.append(RejectedRow("navi", i, "lifted", text, str(err).splitlines()[0]))
             continue
-        records.append(_record(uid, "navi", "lifted", i, detokenize(row["logic_sentence"]), lifted))
-        records.append(_record(uid, "navi", "grounded", i, detokenize(row["sentence"]), grounded))
+        records.append(make_record(uid, "navi", "lifted", i, detokenize(row["logic_sentence"]), lifted))
+        records.append(make_record(uid, "navi", "grounded", i, detokenize(row["sentence"]), grounded))
     return records, rejected
 
 
+def lifted_from_grounded(row: dict) -> Formula | None:
+    """A timed-file row's lifted formula, with the structure of its own grounded ``ltl``.
+
+    Most rows of NL2TL's lifted timed files come from navi's generator, and their lifted
+    ``logic_ltl`` drops parentheses that their grounded ``ltl`` keeps: "at some time
+    (prop_1) or (prop_2)" has ``finally ( prop_1 or prop_2 )`` beside
+    ``F ( scoop_up_v pear_n ) | take_v apple_n``. The grounded formula agrees with
+    navi's label for every sentence the two files share, so it is the label; its
+    predicates are the lifted ``prop_i`` in the same order of occurrence.
+
+    Returns:
+        The formula, or None for a row whose ``ltl`` is not a navi-style formula
+        (signal arithmetic, or empty): its ``logic_ltl`` stays the label.
+    """
+    tokens = row.get("ltl") or []
+    if isinstance(tokens, str):
+        tokens = tokens.split()
+    lifted_atoms = [t for t in row["logic_ltl"] if _LIFTED_NAME.fullmatch(t)]
+    if not tokens or any(t in ("<", ">", "<=", ">=", "==", "[", "rise", "fall") or
+                         _NUMBER.fullmatch(t) for t in tokens):
+        return None
+    text: list[str] = []
+    name: list[str] = []
+    for token in [*tokens, ")"]:
+        if token in _NAVI_OPERATORS:
+            if name:
+                text.append(lifted_atoms.pop(0) if lifted_atoms else "?")
+                name = []
+            text.append(_NAVI_OPERATORS[token])
+        else:
+            name.append(token)
+    if lifted_atoms or "?" in text:
+        return None  # a different number of predicates: not the same formula
+    try:
+        return parse(" ".join(text[:-1]))
+    except ValueError:
+        return None
+
+
 def normalize_timed(rows: list[dict], source: str = "nl2tl_timed",
-                    uid: _UidMaker | None = None) -> tuple[list[Record], list[RejectedRow]]:
-    """NL2TL's timed data: lifted records only (its grounded side is signal arithmetic)."""
-    uid = uid or _UidMaker()
+                    uid: UidMaker | None = None) -> tuple[list[Record], list[RejectedRow]]:
+    """NL2TL's timed data: lifted records only (its grounded side is signal arithmetic
+    or navi-style; see :func:`lifted_from_grounded` for how the latter is used)."""
+    uid = uid or UidMaker()
     records: list[Record] = []
     rejected: list[RejectedRow] = []
     for i, row in enumerate(rows):
         text = lifted_tokens_to_text(row["logic_ltl"])
         try:
-            formula = parse(text)
+            formula = lifted_from_grounded(row) or parse(text)
         except ValueError as err:
             rejected.append(RejectedRow(source, i, "lifted", text, str(err).splitlines()[0]))
             continue
         nl = detokenize(row["logic_sentence"])
-        records.append(_record(uid, source, "lifted", i, nl, formula))
+        records.append(make_record(uid, source, "lifted", i, nl, formula))
     return records, rejected

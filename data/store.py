@@ -22,6 +22,7 @@ from ara.data.handwritten import SUITE, suite_records
 from ara.data.mixture import compositional_split
 from ara.data.normalize import (
     NORMALIZER_VERSION,
+    TIMED_LABELS_VERSION,
     Record,
     RejectedRow,
     normalize_navi,
@@ -103,6 +104,8 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
         parts = (paper_split(records, len(rows), seed) if split == "paper"
                  else disjoint_split(records, seed))
     sources = {name: sha256_file(RAW_DIR / name) for name in files}
+    if split == "timed":
+        sources["timed_labels"] = TIMED_LABELS_VERSION
     return parts, rejected, sources
 
 

@@ -20,7 +20,7 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ara.data.normalize import Record, _UidMaker
+from ara.data.normalize import Record, UidMaker
 from ara.data.vocabulary import Proposition, draw_propositions
 from ara.errors import ConfigError
 from ara.grammars.ast import (
@@ -232,7 +232,7 @@ def synthetic_records(rows: int, seed: int, held_out: bool,
     rng = random.Random(f"{seed}:{'test' if held_out else 'train'}:{SYNTHETIC_VERSION}")
     mode = "test" if held_out else "train"
     syntax = Syntax(aps=None, intervals=True, max_bound=s.max_bound, max_depth=5, max_args=2)
-    uid, records, seen = _UidMaker(), [], set()
+    uid, records, seen = UidMaker(), [], set()
     while len(records) < 2 * rows:
         drawn = pair(rng, s, mode, held_out)
         if drawn is None:

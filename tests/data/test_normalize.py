@@ -6,11 +6,14 @@ import re
 from ara.data.normalize import (
     detokenize,
     grounded_name,
+    lifted_from_grounded,
     lifted_tokens_to_text,
     normalize_navi,
     normalize_timed,
+    read_jsonl,
 )
 from ara.data.store import RAW_DIR
+from ara.grammars import parse
 
 
 def navi_row(ltl, props=None, sentence="when possible pick apple and always go to house"):
@@ -87,3 +90,41 @@ def test_vendored_files_match_their_provenance_note():
     assert sorted(listed) == ["lifted_stl_dev.jsonl", "lifted_stl_train.jsonl", "navi.jsonl"]
     for name, digest in listed.items():
         assert hashlib.sha256((RAW_DIR / name).read_bytes()).hexdigest() == digest
+
+
+def test_timed_navi_style_rows_take_the_structure_of_their_grounded_formula():
+    """NL2TL's lifted transcription of this row lost the parentheses that its grounded
+    ``ltl`` keeps; the grounded structure is the label (row 5434 of the train file)."""
+    row = {"logic_ltl": "finally ( prop_1 or prop_2 )".split(),
+           "logic_sentence": "at some time ( prop_1 ) or ( prop_2 )".split(),
+           "ltl": "F ( scoop_up_v pear_n ) | take_v apple_n".split()}
+    (record,), _ = normalize_timed([row])
+    assert record.stl == "F(prop_1) | prop_2"
+    # The same predicate twice is still two lifted propositions, matched by position.
+    row = {"logic_ltl": "( prop_1 imply prop_2 )".split(),
+           "logic_sentence": "when ( prop_1 ) , ( prop_2 )".split(),
+           "ltl": "go_by_v waste_bin_n -> go_by_v waste_bin_n".split()}
+    assert lifted_from_grounded(row) == parse("prop_1 -> prop_2")
+
+
+def test_timed_signal_rows_keep_their_lifted_label():
+    """Signal arithmetic and empty ``ltl`` fields say nothing about structure."""
+    signal = {"logic_ltl": "globally ( prop_1 imply prop_2 )".split(),
+              "ltl": "G ( signal_1_n > 44.6 -> signal_2_n <= 49.9 )".split()}
+    empty = {"logic_ltl": "finally [4,9] ( prop_1 )".split(), "ltl": ""}
+    assert lifted_from_grounded(signal) is None and lifted_from_grounded(empty) is None
+
+
+def test_timed_files_agree_with_navi_on_every_shared_sentence():
+    """With the restored structure, the two NL2TL sources label every lifted sentence
+    they share the same way (before, about half of the shared sentences disagreed)."""
+    navi, _ = normalize_navi(read_jsonl(RAW_DIR / "navi.jsonl"))
+    labels: dict[str, set[str]] = {}
+    for r in navi:
+        if r.form == "lifted":
+            labels.setdefault(r.nl, set()).add(r.stl)
+    for name in ("lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"):
+        timed, rejected = normalize_timed(read_jsonl(RAW_DIR / name))
+        shared = [r for r in timed if r.nl in labels]
+        assert len(shared) > 1000 and rejected == []
+        assert [r for r in shared if r.stl not in labels[r.nl]] == []

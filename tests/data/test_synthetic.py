@@ -102,7 +102,8 @@ def test_the_compositional_split_keeps_its_test_side_and_nl2tl_dev_out_of_traini
 
     split = load_or_prepare("compositional", 0)
     train, test = split.records("train"), split.records("test")
-    assert {r.source for r in train} == {"navi", "nl2tl_timed_train", "synthetic"}
+    assert {r.source for r in train} == {"navi", "nl2tl_timed_train", "synthetic",
+                                         "help_request"}
     assert {r.source for r in test} == {"synthetic"}
     assert not {shape(r.formula) for r in test} & {shape(r.formula) for r in train}
     assert not {r.nl for r in test} & {r.nl for r in train}
