@@ -39,6 +39,10 @@ def translate_cmd(
              "sentence still comes out untimed."),
     max_bound: int = typer.Option(1000, "--max-bound", min=1,
                                   help="Largest time bound the grammar admits."),
+    any_bound: bool = typer.Option(
+        False, "--any-bound",
+        help="Let intervals use any number up to --max-bound; by default they use only 0 "
+             "and the numbers the sentence writes (digits, or words up to 'hundred')."),
     samples: int = typer.Option(
         1, "--samples", min=1, max=32,
         help="Self-consistency: K answers under the grammar (greedy + K-1 sampled), "
@@ -56,7 +60,8 @@ def translate_cmd(
 
     with user_errors():
         names = split_list(aps)
-        config = TranslatorConfig(intervals=intervals, max_bound=max_bound)
+        config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
+                                  bounds_from_request=not any_bound)
         check_request(nl, names, config)
         if samples > 1 and no_constraint:
             raise ConfigError("--samples decodes under the grammar (every sample valid); "

@@ -53,7 +53,10 @@ def grammar_for_prompt(syntax: Syntax) -> str:
     rules (an exact digit trie, thousands of lines) summarized in one line."""
     gbnf = build_grammar(syntax).grammar.to_gbnf()
     lines = [ln for ln in gbnf.splitlines() if not ln.startswith(("lo", "ge-", "interval "))]
-    if syntax.intervals:
+    if syntax.intervals and syntax.bounds is not None:
+        lines.append(f'interval ::= "[" lo "," hi "]"  # lo <= hi, each one of '
+                     f'{", ".join(map(str, syntax.bounds))}')
+    elif syntax.intervals:
         lines.append(f'interval ::= "[" lo "," hi "]"  # integers, 0 <= lo <= hi <= '
                      f'{syntax.max_bound}')
     return "\n".join(lines)

@@ -82,7 +82,12 @@ def _build_cached(syntax: Syntax) -> BuiltGrammar:
 def _structure_rules(layout: Syntax) -> tuple[Rule, ...]:
     """Every rule but ``atom``: they depend on the layout, never on the propositions,
     so requests with new propositions reuse them."""
-    rules = interval_rules(layout.max_bound, layout.allow_inf) if layout.intervals else []
+    if not layout.intervals:
+        rules = []
+    elif layout.bounds is not None:
+        rules = listed_interval_rules(layout.bounds, layout.allow_inf)
+    else:
+        rules = interval_rules(layout.max_bound, layout.allow_inf)
     rules += _relaxed_rules(layout) if layout.relaxed else _canonical_rules(layout)
     return tuple(rules)
 
@@ -200,6 +205,19 @@ def interval_rules(max_bound: int, allow_inf: bool) -> list[Rule]:
                     alts.append((Lit(digit), Ref(f"lo_{nxt}")))
                     stack.append(nxt)
         rules.append(Rule(f"lo_{prefix}" if prefix else "lo", tuple(alts)))
+    return rules
+
+
+def listed_interval_rules(bounds: tuple[int, ...], allow_inf: bool) -> list[Rule]:
+    """``interval ::= "[" lo "," hi "]"`` with ``lo <= hi``, both from ``bounds``."""
+    rules = [Rule("interval", ((Lit("["), Ref("lo")),)),
+             Rule("lo", tuple((Lit(str(lo)), Lit(","), Ref(f"ge_{lo}"), Lit("]"))
+                              for lo in bounds))]
+    for lo in bounds:
+        his: list[Seq] = [(Lit(str(hi)),) for hi in bounds if hi >= lo]
+        if allow_inf:
+            his.append((Lit("inf"),))
+        rules.append(Rule(f"ge_{lo}", tuple(his)))
     return rules
 
 

@@ -42,6 +42,10 @@ class Syntax:
             grammar can only be built when they are given).
         intervals: Whether ``F``, ``G`` and ``U`` may carry ``[lo,hi]``.
         max_bound: Largest number allowed in an interval, ``>= 0``. Default 1000.
+        bounds: With ``intervals``: the only numbers an interval may use (each
+            ``<= max_bound``), e.g. those an instruction writes and 0; ``None``: every
+            number up to ``max_bound``. A handful of numbers makes a grammar of a few
+            rules instead of two per number up to ``max_bound``.
         allow_inf: Whether ``[lo,inf]`` is allowed.
         allow_next: Whether ``X`` is allowed (NL2TL formulas never use it).
         relaxed: Paper-style layout instead of the canonical one (see module doc).
@@ -52,6 +56,7 @@ class Syntax:
     aps: tuple[str, ...] | None = None
     intervals: bool = False
     max_bound: int = 1000
+    bounds: tuple[int, ...] | None = None
     allow_inf: bool = False
     allow_next: bool = False
     relaxed: bool = False
@@ -71,6 +76,13 @@ class Syntax:
                     )
         if not isinstance(self.max_bound, int) or self.max_bound < 0:
             raise ConfigError(f"max_bound must be an integer >= 0, got {self.max_bound!r}")
+        if self.bounds is not None:
+            bounds = tuple(sorted(set(self.bounds)))
+            if not bounds or not all(isinstance(b, int) and 0 <= b <= self.max_bound
+                                     for b in bounds):
+                raise ConfigError(f"bounds must be a non-empty set of integers in "
+                                  f"0..max_bound={self.max_bound}, got {self.bounds!r}")
+            object.__setattr__(self, "bounds", bounds)
         if self.max_depth is not None and self.max_depth < 1:
             raise ConfigError(f"max_depth must be >= 1 or None, got {self.max_depth!r}")
         if self.max_args is not None and self.max_args < 2:
@@ -85,6 +97,7 @@ class Syntax:
         """Plain-JSON form, for recording in the outputs that used this language."""
         data = asdict(self)
         data["aps"] = list(self.aps) if self.aps is not None else None
+        data["bounds"] = list(self.bounds) if self.bounds is not None else None
         return data
 
     def accepts(self, text: str) -> bool:
@@ -144,6 +157,11 @@ class Syntax:
                 if int(tok.text) > self.max_bound:
                     raise STLSyntaxError(
                         text, tok.start, f"time bound {tok.text} exceeds max_bound={self.max_bound}"
+                    )
+                if self.bounds is not None and int(tok.text) not in self.bounds:
+                    raise STLSyntaxError(
+                        text, tok.start,
+                        f"time bound {tok.text} is not one of {', '.join(map(str, self.bounds))}"
                     )
 
     def _check_shape(self, text: str, formula: Formula) -> None:

@@ -24,6 +24,9 @@ SYNTAXES = {
     "canonical_bounded": Syntax(aps=("a", "b"), intervals=True, max_bound=12, max_depth=3,
                                 max_args=3),
     "canonical_untimed_next": Syntax(aps=("p", "q"), allow_next=True),
+    # A translation request's grammar: only the numbers its sentence writes, and 0.
+    "canonical_listed_bounds": Syntax(aps=("a", "b"), intervals=True, bounds=(0, 3, 12, 250),
+                                      max_depth=3, max_args=2),
     "relaxed": Syntax(aps=("a", "b", "Fa"), intervals=True, max_bound=30, allow_inf=True,
                       relaxed=True),
     "relaxed_untimed": Syntax(aps=("prop_1", "prop_10"), relaxed=True, allow_next=True),
