@@ -27,8 +27,18 @@ class STLSyntaxError(AraError, ValueError):
         self.text = text
         self.position = position
         self.reason = reason
-        caret = " " * position + "^"
-        super().__init__(f"{reason} at position {position}:\n  {text}\n  {caret}")
+        # A window of the text around the position: a 10,000-character input would
+        # otherwise bury the message.
+        start = max(0, position - _CONTEXT)
+        shown = text[start:position + _CONTEXT]
+        prefix = "..." if start else ""
+        suffix = "..." if position + _CONTEXT < len(text) else ""
+        caret = " " * (len(prefix) + position - start) + "^"
+        super().__init__(f"{reason} at position {position}:\n  {prefix}{shown}{suffix}\n"
+                         f"  {caret}")
+
+
+_CONTEXT = 60
 
 
 class BoundTooLargeError(AraError, ValueError):

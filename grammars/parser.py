@@ -34,6 +34,14 @@ from ara.grammars.ast import (
 )
 from ara.grammars.lexer import Kind, Token, tokenize
 
+#: Deepest nesting the parser reads, counted twice: operators inside operators (prefix
+#: operators, chained ``U`` and ``->``), and parentheses inside parentheses. NL2TL's
+#: formulas nest at most 7 deep and decoding grammars 5. The bound keeps the parser and
+#: every recursive walk of a tree far from Python's recursion limit, so deeper input
+#: gets an error instead of a ``RecursionError``; and since the printer adds at most
+#: one level of parentheses per operator, whatever parses also parses once printed.
+MAX_NESTING = 64
+
 
 def parse(text: str) -> Formula:
     """Parse a formula, accepting any whitespace and both ``!`` and ``~``.
@@ -63,6 +71,21 @@ class _Parser:
         self.text = text
         self.tokens = tokens
         self.i = 0
+        self.nesting = {"operators": 0, "parentheses": 0}
+
+    def nested(self, parse_inner, kind: str = "operators"):
+        """``parse_inner()`` one level deeper in ``kind``, refusing to pass the bound."""
+        if self.nesting[kind] >= MAX_NESTING:
+            raise STLSyntaxError(
+                self.text, self.tok.start,
+                f"the formula nests more than {MAX_NESTING} {kind} deep (the parser's "
+                "bound); write it flatter",
+            )
+        self.nesting[kind] += 1
+        try:
+            return parse_inner()
+        finally:
+            self.nesting[kind] -= 1
 
     @property
     def tok(self) -> Token:
@@ -106,7 +129,7 @@ class _Parser:
         lhs = self.disjunction()
         if self.at("->"):
             self.advance()
-            return Implies(lhs, self.implies())
+            return Implies(lhs, self.nested(self.implies))
         return lhs
 
     def disjunction(self) -> Formula:
@@ -128,29 +151,29 @@ class _Parser:
         if self.at("U"):
             self.advance()
             interval = self.interval() if self.at("[") else None
-            return Until(lhs, self.until(), interval)
+            return Until(lhs, self.nested(self.until), interval)
         return lhs
 
     def unary(self) -> Formula:
         if self.at("!", "~"):
             self.advance()
-            return Not(self.unary())
+            return Not(self.nested(self.unary))
         if self.at("F", "G"):
             op = self.advance().text
             interval = self.interval() if self.at("[") else None
-            arg = self.unary()
+            arg = self.nested(self.unary)
             return Eventually(arg, interval) if op == "F" else Always(arg, interval)
         if self.at("X"):
             self.advance()
             if self.at("["):
                 raise self.fail("a formula after X (X takes no interval; nest X or use F[a,b])")
-            return Next(self.unary())
+            return Next(self.nested(self.unary))
         return self.primary()
 
     def primary(self) -> Formula:
         if self.at("("):
             self.advance()
-            inner = self.iff()
+            inner = self.nested(self.iff, "parentheses")
             if not self.at(")"):
                 if self.at("<->"):
                     self.expect_end()
