@@ -1,7 +1,11 @@
 """Robots on a grid asking for help in natural language (the paper's Experiment 2).
 
-Landed so far: grid worlds and the exact DP planner. The STL-to-MILP compiler, the
-help protocol, the Oracle and the baselines come with the rest of their issue.
+Grid worlds (:mod:`~ara.coordination.world`), the exact DP planner and the event
+STL-to-MILP planner (:mod:`~ara.coordination.planner_dp`,
+:mod:`~ara.coordination.planner_milp`), the help protocol
+(:mod:`~ara.coordination.protocol`), the Oracle and baselines
+(:mod:`~ara.coordination.oracle`) and the experiment
+(:mod:`~ara.coordination.experiment2`).
 """
 
 from ara.coordination.planner_dp import Job, Plan, plan_jobs

@@ -25,7 +25,7 @@ from functools import cached_property
 from ara.coordination.milp import LinearModel, MILPSolver, make_solver
 from ara.coordination.planner_dp import Job, leg_lengths
 from ara.coordination.world import Cell, GridWorld
-from ara.errors import AraError
+from ara.errors import AraError, ConfigError
 
 OVER_CAP_PENALTY = 1000
 
@@ -51,6 +51,17 @@ class Fleet:
     jobs: tuple[Job, ...]
     help_job: int | None = None
     cap: int | None = 50
+
+    def __post_init__(self) -> None:
+        if not self.starts:
+            raise FleetError("a fleet needs at least one robot: give each robot's start cell")
+        for k, start in enumerate(self.starts):
+            self.world.require_free(start, f"robot {k}'s start")
+        if self.help_job is not None and not 0 <= self.help_job < len(self.jobs):
+            raise FleetError(f"help_job {self.help_job} is not a job index "
+                             f"(0..{len(self.jobs) - 1})")
+        if self.cap is not None and self.cap < 0:
+            raise FleetError(f"cap must be >= 0 or None, got {self.cap}")
 
     @cached_property
     def legs(self) -> tuple[list[list[int]], list[list[int]]]:
@@ -137,7 +148,8 @@ class ILSSettings:
     Args:
         iterations: Perturb + local-search rounds.
         perturb_moves: Random relocations per perturbation.
-        temperature: T in the acceptance probability exp(-(J' - J) / T) for worse J'.
+        temperature: T in the acceptance probability exp(-(J' - J) / T) for worse J';
+            0 accepts improvements only.
         seed: For the perturbations and the acceptance draws.
     """
 
@@ -145,6 +157,13 @@ class ILSSettings:
     perturb_moves: int = 2
     temperature: float = 1.0
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.iterations < 0 or self.perturb_moves < 1 or not self.temperature >= 0:
+            raise ConfigError(
+                f"ILS needs iterations >= 0, perturb_moves >= 1 and temperature >= 0 (0: "
+                f"accept improvements only); got {self.iterations}, {self.perturb_moves}, "
+                f"{self.temperature}")
 
 
 def _moves(routes: list[list[int]], pinned: dict[int, int]):
@@ -220,7 +239,8 @@ def ils(fleet: Fleet, settings: ILSSettings = ILSSettings(),
         cand = _perturb(current, rng, settings.perturb_moves, pinned)
         cand = local_search(fleet, cand, pinned)
         c = _penalized(fleet, cand)
-        if c < cur_cost or rng.random() < math.exp(-(c - cur_cost) / settings.temperature):
+        if c < cur_cost or (settings.temperature > 0 and
+                            rng.random() < math.exp(-(c - cur_cost) / settings.temperature)):
             current, cur_cost = cand, c
         if c < best_cost:
             best, best_cost = cand, c

@@ -75,6 +75,7 @@ def plan_spec(world: GridWorld, start: Cell, conjuncts: dict[str, Formula],
 
     Raises:
         UnsupportedSpec: The spec is outside the event fragment.
+        WorldError: The start or a cell the spec must visit is not free.
     """
     if objective not in OBJECTIVES:
         raise ConfigError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
@@ -86,6 +87,9 @@ def solve_program(world: GridWorld, start: Cell, program: EventProgram, vocab: V
                   objective: str = "makespan", cap: int | None = None,
                   solver: MILPSolver | None = None, time_limit_s: float = 10.0) -> EventPlan:
     events = program.events
+    world.require_free(start, "the start")
+    for e in events:
+        world.require_free(vocab.events[e], f"event {e!r} at")
     if not events:
         return EventPlan("optimal", help_time=0 if "help" in program.groups else None)
     cells = {START: start, **{e: vocab.events[e] for e in events}}

@@ -30,7 +30,7 @@ from ara.coordination.specs import (
     place_ap,
     pnp_spec,
 )
-from ara.coordination.world import Cell, GridWorld
+from ara.coordination.world import Cell, GridWorld, WorldError
 from ara.errors import AraError
 from ara.grammars import And, Formula, parse
 from ara.grammars import to_text as stl_text
@@ -296,7 +296,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
                           {"own": jobs_spec(list(helper.jobs), (pick, place)),
                            "help": help_formula},
                           vocab, objective, cap, solver)
-    except UnsupportedSpec as err:
+    except (UnsupportedSpec, WorldError) as err:
         return _decline(helper, str(err), stl_text(help_formula))
     if not after.feasible:
         return _decline(helper, f"no plan satisfies my spec and the help request "

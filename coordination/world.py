@@ -110,6 +110,20 @@ class GridWorld:
     def is_free(self, cell: Cell) -> bool:
         return self.in_bounds(cell) and cell not in self.obstacles
 
+    def require_free(self, cell: Cell, what: str) -> None:
+        """Refuse a cell a robot cannot stand on, saying why.
+
+        Raises:
+            WorldError: ``cell`` is outside the grid or an obstacle.
+        """
+        if not self.in_bounds(cell):
+            raise WorldError(f"{what} {cell} is outside the {self.rows}x{self.cols} grid "
+                             f"(rows 0-{self.rows - 1}, columns 0-{self.cols - 1})")
+        if cell in self.obstacles:
+            near = sorted(self.free_cells, key=lambda f: abs(f[0] - cell[0]) + abs(f[1] - cell[1]))
+            raise WorldError(f"{what} {cell} is an obstacle of this world; free cells near it: "
+                             f"{', '.join(map(str, near[:3]))}")
+
     @cached_property
     def free_cells(self) -> tuple[Cell, ...]:
         """Free cells in row-major order."""

@@ -53,6 +53,10 @@ class Variant:
         return cls(canonical, **{LETTERS[x]: x in letters for x in LETTERS})
 
 
+#: Most worked examples one prompt shows (20-shot prompts are about 1,000 tokens).
+MAX_SHOTS = 50
+
+
 @dataclass(frozen=True)
 class AblationConfig:
     """One ablation run.
@@ -62,7 +66,8 @@ class AblationConfig:
             ``handwritten``).
         form: ``lifted`` or ``grounded`` records.
         variants: Variant names, e.g. ``("F", "F+P", "F+P+C")``.
-        shots: Few-shot counts for the F variants.
+        shots: Few-shot counts for the F variants, 0 to 50 (0: F runs zero-shot;
+            variants without F always do).
         reruns: Reruns, each with freshly drawn examples.
         limit: Test pairs, sampled once with ``seed``.
         seed: Seeds the test sample and every rerun's examples.
@@ -94,9 +99,11 @@ class AblationConfig:
             # NL2TL's timed formulas carry intervals: a grammar without them could not
             # express a single reference.
             object.__setattr__(self, "translator", replace(self.translator, intervals=True))
-        if not self.variants or any(k < 1 for k in self.shots) or self.reruns < 1 or self.limit < 1:
+        if (not self.variants or any(not 0 <= k <= MAX_SHOTS for k in self.shots)
+                or self.reruns < 1 or self.limit < 1):
             raise ConfigError(
-                "need at least one variant, shots >= 1, reruns >= 1 and limit >= 1; got "
+                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1 and "
+                "limit >= 1; got "
                 f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
                 f"limit={self.limit}"
             )

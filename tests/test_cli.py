@@ -140,6 +140,11 @@ def test_coord_plan_and_its_errors(tmp_path):
     bad.write_text("..\n.x\n")
     out = ara("coord", "plan", "F a", "--at", "a=0,0", "--world", str(bad))
     assert out.returncode == 2 and "bad.txt:2:2: unexpected 'x'" in out.stderr
+    # A cell a robot cannot stand on is named, with the free cells beside it.
+    out = ara("coord", "plan", "F(a)", "--at", "a=1,1")
+    assert out.returncode == 2 and "(1, 1) is an obstacle" in out.stderr
+    out = ara("coord", "plan", "F(a)", "--at", "a=0,7", "--start", "9,9")
+    assert out.returncode == 2 and "outside the 8x8 grid" in out.stderr
     out = ara("coord", "exp2", "--out", str(tmp_path / "e"), "--llm", "default")
     assert out.returncode == 2 and "--planner milp" in out.stderr
 

@@ -47,6 +47,8 @@ class LoRAFinetuneRecipe:
         self.resume = resume
         if self.out.joinpath("run.json").exists() and not resume:
             raise ConfigError(f"{self.out} already holds a run: pass --resume or another out")
+        if resume and self.out.joinpath("run.json").exists():
+            _refuse_changed_config(self.out / "run.json", config)
         self.step = 0
 
     # -- setup: each part needs the ones before it ------------------------------------
@@ -139,13 +141,19 @@ class LoRAFinetuneRecipe:
                    disable=not self.accelerator.is_main_process, dynamic_ncols=True)
         log = open(self.out / "train_log.jsonl", "a")
         self.model.train()
+        # One optimizer step spans grad_accum micro-batches: its log line sums their
+        # time and tokens and averages their losses.
+        micro_losses: list[float] = []
+        micro_shots: list[int] = []
+        tokens, start = 0, time.perf_counter()
         try:
             while self.step < self.total_steps:
                 epoch, done = divmod(self.step, self.steps_per_epoch)
                 skip = done * cfg.optim.grad_accum
                 for index, micro in enumerate(batches(self.train_records, cfg.optim.batch_size,
                                                       cfg.seed, epoch, skip), start=skip):
-                    start = time.perf_counter()
+                    if not micro_losses:
+                        start = time.perf_counter()
                     shots = self._shots(micro, epoch, index)
                     examples = encode(micro, self.tokenizer, shots)
                     batch = {k: v.to(self.accelerator.device)
@@ -156,20 +164,24 @@ class LoRAFinetuneRecipe:
                         self.optimizer.step()
                         self.scheduler.step()
                         self.optimizer.zero_grad()
+                    micro_losses.append(loss.item())
+                    micro_shots.append(len(shots))
+                    tokens += int(batch["attention_mask"].sum())
                     if not self.accelerator.sync_gradients:
                         continue
                     self.step += 1
-                    losses.append(loss.item())
-                    tokens = int(batch["attention_mask"].sum())
+                    losses.append(sum(micro_losses) / len(micro_losses))
                     seconds = time.perf_counter() - start
                     rate = tokens / seconds
                     log.write(json.dumps({"step": self.step, "epoch": epoch,
                                           "loss": round(losses[-1], 5),
                                           "lr": self.scheduler.get_last_lr()[0],
-                                          "shots": len(shots),
+                                          "shots": (micro_shots[0] if len(micro_shots) == 1
+                                                    else micro_shots),
                                           "tokens_per_s": round(rate, 1),
                                           "seconds": round(seconds, 2)}) + "\n")
                     log.flush()
+                    micro_losses, micro_shots, tokens = [], [], 0
                     bar.set_postfix(loss=f"{losses[-1]:.3f}", tok_s=f"{rate:.0f}", refresh=False)
                     bar.update()
                     if self.step % cfg.checkpoint_every == 0:
@@ -240,6 +252,32 @@ class LoRAFinetuneRecipe:
                   "accuracy": min(v["accuracy"] for v in by_shots.values())}
         self.out.joinpath("heldout.json").write_text(json.dumps(report, indent=2) + "\n")
         return report
+
+
+#: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
+#: how often it checkpoints, and the held-out check at its end.
+_RESUMABLE_KEYS = {"max_steps", "eval_pairs", "checkpoint_every"}
+
+
+def _flat(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        out.update(_flat(v, f"{prefix}{k}.") if isinstance(v, dict) else {f"{prefix}{k}": v})
+    return out
+
+
+def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
+    """A resumed run continues the same training: the same data, schedule and model."""
+    saved = _flat(json.loads(run_json.read_text())["config"])
+    now = _flat(config.to_dict())
+    changed = sorted(k for k in saved.keys() | now.keys()
+                     if saved.get(k) != now.get(k) and k not in _RESUMABLE_KEYS)
+    if changed:
+        detail = ", ".join(f"{k}: {saved.get(k)!r} -> {now.get(k)!r}" for k in changed)
+        raise ConfigError(
+            f"--resume: the config differs from the one {run_json.parent} was started with "
+            f"({detail}); resume with the same config (only max_steps, checkpoint_every and "
+            "eval_pairs may change), or train into another out folder")
 
 
 def main(config_path: str, max_steps: int | None = None, resume: bool = False) -> dict:

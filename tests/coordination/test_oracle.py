@@ -16,7 +16,8 @@ from ara.coordination.oracle import (
     ils,
 )
 from ara.coordination.planner_dp import Job
-from ara.coordination.world import GridWorld
+from ara.coordination.world import GridWorld, WorldError
+from ara.errors import ConfigError
 
 WORLD = GridWorld.paper()
 
@@ -74,6 +75,22 @@ def test_ils_is_never_worse_than_greedy_nor_better_than_the_optimum(seed):
     optimum = exact(fleet)
     assert optimum.cost <= found.cost <= greedy.cost
     assert found.feasible and sorted(j for r in found.routes for j in r) == list(range(13))
+
+
+def test_settings_and_fleets_check_their_ranges():
+    """A zero temperature accepts improvements only; impossible values are refused."""
+    fleet = Fleet(WORLD, ((0, 0), (7, 7)), (Job((0, 2), (0, 3)), Job((7, 5), (7, 6))))
+    assert ils(fleet, ILSSettings(temperature=0, iterations=5)).feasible
+    with pytest.raises(ConfigError, match="temperature >= 0"):
+        ILSSettings(temperature=-1)
+    with pytest.raises(ConfigError, match="perturb_moves >= 1"):
+        ILSSettings(perturb_moves=0)
+    with pytest.raises(FleetError, match="at least one robot"):
+        Fleet(WORLD, (), (Job((0, 2), (0, 3)),))
+    with pytest.raises(FleetError, match="not a job index"):
+        Fleet(WORLD, ((0, 0),), (Job((0, 2), (0, 3)),), help_job=3)
+    with pytest.raises(WorldError, match="is an obstacle"):
+        Fleet(WORLD, ((1, 1),), (Job((0, 2), (0, 3)),))
 
 
 def test_unreachable_jobs_are_a_clear_error():

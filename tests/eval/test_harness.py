@@ -54,6 +54,16 @@ def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):
     assert rerun_examples[0] != rerun_examples[1]  # examples are redrawn per rerun
 
 
+def test_zero_shots_runs_f_zero_shot_and_too_many_is_refused(paper_split):
+    """A user asking for zero worked examples gets them; 99,999 gets the range."""
+    config = AblationConfig(variants=("F+C", "C"), shots=(0, 2), reruns=1, limit=3)
+    jobs = list(plan(config, paper_split))
+    assert {(j.variant.name, j.shots) for j in jobs} == {("F+C", 0), ("F+C", 2), ("C", 0)}
+    assert all(j.examples == () for j in jobs if j.shots == 0)
+    with pytest.raises(ConfigError, match="shots from 0 to 50"):
+        AblationConfig(shots=(99999,))
+
+
 def test_grammars_admit_intervals_and_the_timed_split_insists():
     """Tests that intervals are on by default, and that the timed split keeps them on
     even when a config turns them off (its references need them)."""

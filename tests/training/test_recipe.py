@@ -4,6 +4,7 @@ import json
 
 import pytest
 
+from ara.errors import ConfigError
 from ara.training.config import TrainConfig
 from ara.training.recipe import LoRAFinetuneRecipe
 
@@ -47,6 +48,11 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
     assert len(resumed.train()) == 2 and resumed.step == 8
     with pytest.raises(Exception, match="already holds a run"):
         LoRAFinetuneRecipe(config)
+    # Resuming with another learning rate would silently train something else.
+    changed = TrainConfig.from_dict({**config.to_dict(), "optim": {**config.to_dict()["optim"],
+                                                                   "lr": 1e-3}})
+    with pytest.raises(ConfigError, match=r"optim.lr: 0.005 -> 0.001"):
+        LoRAFinetuneRecipe(changed, resume=True)
 
 
 def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path):
@@ -146,3 +152,19 @@ def test_two_steps_reproduce_the_golden_losses(tiny_gemma_dir, tmp_path):
     recipe = LoRAFinetuneRecipe(config)
     recipe.setup()
     assert recipe.train() == pytest.approx(golden["losses"], rel=1e-4)
+
+
+def test_a_step_of_several_micro_batches_logs_all_of_them(tiny_gemma_dir, tmp_path):
+    """With grad_accum 2, one logged step covers both micro-batches (their shot counts,
+    their summed tokens and time, their mean loss), not the last one alone."""
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2,
+                         optim={"lr": 5e-3, "batch_size": 2, "grad_accum": 2,
+                                "warmup_steps": 0, "epochs": 2},
+                         data={"forms": ["lifted"], "limit": 8, "shots": [0, 2]})
+    recipe = LoRAFinetuneRecipe(config)
+    recipe.setup()
+    losses = recipe.train()
+    log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]
+    assert [x["step"] for x in log] == [1, 2] and len(losses) == 2
+    assert all(isinstance(x["shots"], list) and len(x["shots"]) == 2 for x in log)
+    assert [x["loss"] for x in log] == [round(v, 5) for v in losses]
