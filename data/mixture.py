@@ -29,8 +29,8 @@ from pathlib import Path
 
 from ara.data.help_requests import HELP_REQUEST_ROWS, help_request_records
 from ara.data.normalize import (
-    Record,
     TIMED_LABELS_VERSION,
+    Record,
     RejectedRow,
     normalize_navi,
     normalize_timed,

@@ -165,8 +165,10 @@ def normalize_navi(rows: list[dict]) -> tuple[list[Record], list[RejectedRow]]:
         except (ValueError, ASTError, KeyError, IndexError) as err:
             rejected.append(RejectedRow("navi", i, "lifted", text, str(err).splitlines()[0]))
             continue
-        records.append(make_record(uid, "navi", "lifted", i, detokenize(row["logic_sentence"]), lifted))
-        records.append(make_record(uid, "navi", "grounded", i, detokenize(row["sentence"]), grounded))
+        records.append(make_record(uid, "navi", "lifted", i, detokenize(row["logic_sentence"]),
+                                   lifted))
+        records.append(make_record(uid, "navi", "grounded", i, detokenize(row["sentence"]),
+                                   grounded))
     return records, rejected
 
 

@@ -120,10 +120,6 @@ def shipped_translator():
 
 
 @pytest.mark.llm
-@pytest.mark.xfail(strict=True, reason=(
-    "issue 10, open: the shipped 270M does not yet write the template's pick-before-place "
-    "spec for a help request (bench/help_request_wordings.py: 0/55 on 2026-11-22); strict, "
-    "so this fails the day it passes and the bench and README get updated"))
 @pytest.mark.parametrize("wording", [0, 3, 7])  # the paper's words and two rewordings
 def test_the_shipped_translator_reads_a_reworded_request_as_the_template_spec(
         shipped_translator, wording):
