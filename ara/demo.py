@@ -31,7 +31,7 @@ def demo_cmd(
 
     from ara.data import prepare
     from ara.grammars import Syntax, build_grammar, parse
-    from ara.grammars.llama_check import LlamaGrammarChecker
+    from ara.eval.llama_check import LlamaGrammarChecker
     from ara.grammars.spot_bridge import equivalent, implies
 
     typer.echo("== data: versioned splits")

@@ -49,7 +49,7 @@ def main() -> None:
     args = ap.parse_args()
 
     from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-    from ara.grammars.llama_check import default_model_path
+    from ara.eval.llama_check import default_model_path
 
     split = load_split("paper")
     rng = random.Random(0)

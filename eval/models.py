@@ -40,7 +40,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     """
     if model == "default":
         from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.grammars.llama_check import default_model_path
+        from ara.eval.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
     if model in SHIPPED_ADAPTERS or model.startswith("lora:"):
@@ -51,7 +51,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
                 "or use --model default, or a GGUF path from `ara export`"
             )
         from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.grammars.llama_check import default_model_path
+        from ara.eval.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask,
                                lora_path=str(lora))

@@ -39,7 +39,7 @@ import json, sys
 from pathlib import Path
 from ara.data import load_or_prepare
 from ara.eval.models import SHIPPED
-from ara.grammars.llama_check import default_model_path
+from ara.eval.llama_check import default_model_path
 from ara.provenance import sha256_file
 from ara.training.export import parity
 run, name, split = Path(sys.argv[1]), sys.argv[2], sys.argv[3]

@@ -68,7 +68,7 @@ def test_grammar_output_loads_in_llama_cpp_and_lark():
     parser = lark.Lark(lark_text, start="start", parser="earley", lexer="dynamic")
     parser.parse("F a & G !b")
     pytest.importorskip("llama_cpp", reason="needs llama-cpp-python (make setup)")
-    from ara.grammars.llama_check import LlamaGrammarChecker
+    from ara.eval.llama_check import LlamaGrammarChecker
 
     checker = LlamaGrammarChecker(gbnf)
     assert checker.accepts("F[2,5](a) & G(!b)") and not checker.accepts("F[2,25](a)")

@@ -38,3 +38,25 @@ def test_rename_atoms_keeps_structure_and_intervals():
     f = Until(Atom("prop_1"), Not(Atom("prop_2")), Interval(1, 3))
     g = rename_atoms(f, {"prop_1": "at_door", "prop_2": "holding_box"})
     assert g == Until(Atom("at_door"), Not(Atom("holding_box")), Interval(1, 3))
+
+
+def test_the_language_core_needs_no_language_model():
+    """`ara.grammars` (AST, parser, printer, grammars, Spot bridge, English) loads
+    without llama.cpp, torch or transformers: the LLM parts live in `ara.eval`."""
+    import subprocess
+    import sys
+
+    code = ("import sys, ara.grammars, ara.grammars.spot_bridge, ara.grammars.english; "
+            "print(sorted({'llama_cpp', 'torch', 'transformers'} & set(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "[]"
+    # Nor does any of its modules reach for one lazily.
+    from pathlib import Path
+
+    import ara.grammars
+
+    for module in Path(ara.grammars.__file__).parent.glob("*.py"):
+        text = module.read_text()
+        assert not any(name in text for name in ("llama_cpp", "import torch",
+                                                 "transformers")), module.name
