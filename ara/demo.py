@@ -30,8 +30,8 @@ def demo_cmd(
     import lark
 
     from ara.data import prepare
-    from ara.grammars import Syntax, build_grammar, parse
     from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.grammars import Syntax, build_grammar, parse
     from ara.grammars.spot_bridge import equivalent, implies
 
     typer.echo("== data: versioned splits")

@@ -22,8 +22,8 @@ import numpy as np
 
 from ara.eval.backends.base import BackendError, Completion, Sampling
 from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
-from ara.grammars import BuiltGrammar
 from ara.eval.llama_check import muted_llama_log
+from ara.grammars import BuiltGrammar
 from ara.provenance import sha256_file
 
 MASK_ENGINES = ("llguidance", "llama")
