@@ -63,8 +63,12 @@ class Exp2Config:
     ils_iterations: int = 100
 
     def __post_init__(self) -> None:
-        if self.trials < 1 or self.robots < 1 or self.jobs < 0:
-            raise ConfigError("need trials >= 1, robots >= 1 and jobs >= 0")
+        if (self.trials < 1 or self.robots < 1 or self.jobs < 0 or self.cap < 1
+                or self.ils_iterations < 0):
+            raise ConfigError(
+                "need trials >= 1, robots >= 1, jobs >= 0, cap >= 1 and ils_iterations >= 0; "
+                f"got {self.trials}, {self.robots}, {self.jobs}, {self.cap}, "
+                f"{self.ils_iterations}")
         if self.planner not in ("dp", "milp"):
             raise ConfigError(f"--planner must be dp or milp, got {self.planner!r}")
         if self.llm != "none" and self.planner == "dp":

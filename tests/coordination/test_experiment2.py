@@ -81,6 +81,12 @@ def test_llm_requests_need_the_milp():
         Exp2Config(llm="default", planner="dp")
 
 
+@pytest.mark.parametrize("bad", [{"trials": 0}, {"cap": 0}, {"ils_iterations": -1}])
+def test_the_config_checks_its_ranges(bad):
+    with pytest.raises(ConfigError, match="cap >= 1"):
+        Exp2Config(**bad)
+
+
 def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
                                                                        llama_backend):
     """Tests that run.json names the translator's model (file hashes), and that the
