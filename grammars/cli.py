@@ -57,9 +57,8 @@ def equiv_cmd(
     """Whether A and B hold on exactly the same traces (decided by Spot)."""
     from ara.grammars.spot_bridge import equivalent
 
-    with user_errors():
-        result = equivalent(parse(a), parse(b), timeout_s=timeout)
-    emit({"equivalent": result}, as_json, lambda v: "equivalent" if result else "not equivalent")
+    _spot_verdict(equivalent, a, b, as_json, timeout, "equivalent",
+                  ("equivalent", "not equivalent"))
 
 
 @stl_app.command("implies")
@@ -72,9 +71,16 @@ def implies_cmd(
     """Whether A implies B: every trace satisfying A satisfies B (decided by Spot)."""
     from ara.grammars.spot_bridge import implies
 
+    _spot_verdict(implies, a, b, as_json, timeout, "implies",
+                  ("A implies B", "A does not imply B"))
+
+
+def _spot_verdict(decide, a: str, b: str, as_json: bool, timeout: float, key: str,
+                  words: tuple[str, str]) -> None:
+    """Parse both formulas, ask Spot, print ``{key: verdict}`` or the verdict's words."""
     with user_errors():
-        result = implies(parse(a), parse(b), timeout_s=timeout)
-    emit({"implies": result}, as_json, lambda v: "A implies B" if result else "A does not imply B")
+        result = decide(parse(a), parse(b), timeout_s=timeout)
+    emit({key: result}, as_json, lambda v: words[0] if result else words[1])
 
 
 class GrammarFormat(str, Enum):
