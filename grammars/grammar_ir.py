@@ -131,23 +131,21 @@ class Grammar:
     @_memoized
     def to_gbnf(self) -> str:
         """The grammar in llama.cpp's GBNF; the start rule is named ``root``."""
-        name = {r.name: ("root" if r.name == self.root else _gbnf_name(r.name))
-                for r in self.rules}
-        lines = []
-        for rule in self.rules:
-            alts = " | ".join(_seq_text(seq, name, _quote, _gbnf_chars) for seq in rule.alts)
-            lines.append(f"{name[rule.name]} ::= {alts}")
-        return "\n".join(lines) + "\n"
+        return self._emit("root", _gbnf_name, " ::= ", _gbnf_chars)
 
     @_memoized
     def to_lark(self) -> str:
         """The grammar in Lark syntax (outlines, llguidance); the start rule is ``start``."""
-        name = {r.name: ("start" if r.name == self.root else "r_" + r.name) for r in self.rules}
-        lines = []
-        for rule in self.rules:
-            alts = " | ".join(_seq_text(seq, name, _quote, _lark_chars) for seq in rule.alts)
-            lines.append(f"{name[rule.name]}: {alts}")
-        return "\n".join(lines) + "\n"
+        return self._emit("start", lambda rule: "r_" + rule, ": ", _lark_chars)
+
+    def _emit(self, root: str, rename, define: str, chars) -> str:
+        """One rule a line, ``name<define>alt | alt``; the two formats differ only in
+        rule names, the definition sign and how a character class is written."""
+        name = {r.name: (root if r.name == self.root else rename(r.name)) for r in self.rules}
+        return "".join(
+            name[rule.name] + define
+            + " | ".join(_seq_text(seq, name, _quote, chars) for seq in rule.alts) + "\n"
+            for rule in self.rules)
 
     @_memoized
     def sha256(self) -> str:
