@@ -12,6 +12,7 @@ import re
 from collections import Counter
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass
+from itertools import groupby
 from pathlib import Path
 
 from ara.errors import AraError
@@ -32,9 +33,8 @@ _OPERATOR_WORDS = {
 }
 _POS_TAG = re.compile(r"_(v|n|a|adj|adv)$")
 # The operator tokens of navi-style grounded formulas (``G ( - ( go_to_v house_n ) )``);
-# every other token is part of a predicate name.
-_NAVI_OPERATORS = {"G": "G", "F": "F", "U": "U", "-": "!", "&": "&", "|": "|",
-                   "->": "->", "(": "(", ")": ")"}
+# a run of other tokens is one predicate name.
+_NAVI_OPERATORS = frozenset({"G", "F", "U", "-", "&", "|", "->", "(", ")"})
 _LIFTED_NAME = re.compile(r"prop_\d+")
 _NUMBER = re.compile(r"-?\d+(\.\d+)?")
 
@@ -193,20 +193,20 @@ def lifted_from_grounded(row: dict) -> Formula | None:
     if not tokens or any(t in ("<", ">", "<=", ">=", "==", "[", "rise", "fall") or
                          _NUMBER.fullmatch(t) for t in tokens):
         return None
-    text: list[str] = []
-    name: list[str] = []
-    for token in [*tokens, ")"]:
-        if token in _NAVI_OPERATORS:
-            if name:
-                text.append(lifted_atoms.pop(0) if lifted_atoms else "?")
-                name = []
-            text.append(_NAVI_OPERATORS[token])
-        else:
-            name.append(token)
-    if lifted_atoms or "?" in text:
-        return None  # a different number of predicates: not the same formula
+    lifted: list[str] = []
+    names = iter(lifted_atoms)
+    for is_operator, run in groupby(tokens, key=_NAVI_OPERATORS.__contains__):
+        if is_operator:
+            lifted += run
+            continue
+        name = next(names, None)
+        if name is None:
+            return None  # more predicates than propositions: not the same formula
+        lifted.append(name)
+    if next(names, None) is not None:
+        return None  # fewer predicates than propositions
     try:
-        return parse(" ".join(text[:-1]))
+        return parse(lifted_tokens_to_text(lifted))
     except ValueError:
         return None
 

@@ -130,11 +130,14 @@ _NUMBER_WORDS |= {w: 10 * (i + 3) for i, w in enumerate(
     "thirty forty fifty sixty seventy eighty ninety".split())} | {"hundred": 100}
 
 
+def _digit_numbers(nl: str) -> list[int]:
+    return [int(n) for n in re.findall(r"\d+", nl)]
+
+
 def request_numbers(nl: str) -> set[int]:
     """The numbers an instruction writes, as digits or as words ("ten", "thirty")."""
     words = re.findall(r"[a-z]+", nl.lower())
-    return ({int(n) for n in re.findall(r"\d+", nl)}
-            | {_NUMBER_WORDS[w] for w in words if w in _NUMBER_WORDS})
+    return set(_digit_numbers(nl)) | {_NUMBER_WORDS[w] for w in words if w in _NUMBER_WORDS}
 
 
 def mentions(nl: str, ap: str) -> bool:
@@ -162,7 +165,7 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
             f"the instruction {nl!r} never mentions {', '.join(unmentioned)}: each proposition "
             "in --aps must be named in the sentence (by its name or a word of it, e.g. "
             "go_to_kitchen by 'kitchen'); drop the others from --aps")
-    numbers = [int(n) for n in re.findall(r"\d+", nl)]  # words stop at a hundred
+    numbers = _digit_numbers(nl)  # digits only: the grammar drops number words above it
     if config.intervals and numbers and max(numbers) > config.max_bound:
         raise RequestError(
             f"the instruction mentions {max(numbers)}, above the grammar's largest time bound "

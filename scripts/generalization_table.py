@@ -56,12 +56,14 @@ def cell(samples: list[dict], seen: set[str]) -> dict:
     }
 
 
-def collect(results: Path, stale: list[str]) -> dict:
+def collect(results: Path) -> tuple[dict, list[str]]:
+    """The table, and the runs left out because their test data is not the current."""
     from ara.data import load_or_prepare
 
     table: dict = defaultdict(dict)
+    stale: list[str] = []
     current = {split: {(r.nl, r.stl) for r in load_or_prepare(split, 0).records("test")}
-               for split, _ in SETS}
+               for split in {split for split, _ in SETS}}
     for folder, (_, trained_on) in MODELS.items():
         seen = training_sentences(trained_on)
         for split, form in SETS:
@@ -78,7 +80,7 @@ def collect(results: Path, stale: list[str]) -> dict:
                 by_variant[(s["variant"], s["shots"])].append(s)
             for key, samples in by_variant.items():
                 table[(split, form, *key)][folder] = cell(samples, seen)
-    return table
+    return table, stale
 
 
 def markdown(table: dict) -> str:
@@ -110,8 +112,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, default=Path("docs/results/generalization"))
     args = parser.parse_args()
-    stale: list[str] = []
-    table = collect(args.results, stale)
+    table, stale = collect(args.results)
     print(markdown(table))
     print("\nCells: accuracy / validity in %; (unseen ...): accuracy on the pairs whose "
           "sentence is not in that model's training data.")
