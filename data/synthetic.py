@@ -1,12 +1,18 @@
 """Seeded synthetic NL/STL pairs: formulas drawn from the project's own language,
 worded by the English realizer (:mod:`ara.grammars.english`).
 
-Half of the formulas are patterns users write (reach, avoid, sequence, response,
-recurrence, persistence, bounded reach and avoid, until), 28% two patterns joined by a
-connective, and 22% grow at random over every operator of the grammar (``!``, ``&``,
-``|``, ``->``, ``<->``, ``F``, ``G``, ``U``, each temporal one timed or not) up to depth
-4. A formula has 1 to 5 propositions, and one may occur twice. Each row is worded
+Most formulas are what users write: 40% one pattern (reach, avoid, sequence,
+response, recurrence, persistence, bounded reach and avoid, until), 30% two patterns
+joined by a connective, 15% three patterns that must all hold; the other 15% grow at
+random over every operator of the grammar (``!``, ``&``, ``|``, ``->``, ``<->``, ``F``,
+``G``, ``U``, each temporal one timed or not) up to depth 4. A pattern's operand is now
+and then a small Boolean formula ("both a and b", "a or b", "not a"), so that scope is
+learned. A formula has 1 to 5 propositions, and one may occur twice. Each row is worded
 twice: lifted (``prop_1``...) and grounded (``go_to_kitchen``...).
+
+In grounded form a proposition read at the first instant only (``a`` in ``a -> F(b)``)
+is a condition ("the door is open"), never an action: a command said on its own ("go
+to the kitchen") means *at some point*, and is written ``F(go_to_kitchen)``.
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -36,6 +42,7 @@ from ara.grammars.ast import (
     Or,
     Until,
     atoms,
+    atoms_read_now,
     depth,
     map_children,
     rename_atoms,
@@ -45,7 +52,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "1.0.0"
+SYNTHETIC_VERSION = "2.0.0"
 SOURCE = "synthetic"
 
 
@@ -139,17 +146,39 @@ def _leaf_drawer(rng: random.Random, names: list[str]) -> Callable[[], Formula]:
     return leaf
 
 
+def _operand_drawer(rng: random.Random, leaf: Callable[[], Formula]
+                    ) -> Callable[[], Formula]:
+    """A pattern's operands: mostly a proposition, now and then a small Boolean one."""
+
+    def operand() -> Formula:
+        roll = rng.random()
+        if roll < 0.06:
+            return Or((leaf(), leaf()))
+        if roll < 0.11:
+            return And((leaf(), leaf()))
+        if roll < 0.14:
+            return Not(leaf())
+        return leaf()
+
+    return operand
+
+
 def sample_formula(rng: random.Random, s: SynthSettings, names: list[str]) -> Formula:
     """A formula over (some of) ``names``, within ``s.max_depth``; binary & and |."""
     while True:
         leaf = _leaf_drawer(rng, names)
+        operand = _operand_drawer(rng, leaf)
         kind = rng.random()
-        if kind < 0.5:
-            f = _pattern(rng, s, leaf)
-        elif kind < 0.78:
-            op = rng.choice((And, Or, And, Implies, Iff))
-            parts = (_pattern(rng, s, leaf), _pattern(rng, s, leaf))
+        if kind < 0.4:
+            f = _pattern(rng, s, operand)
+        elif kind < 0.7:
+            op = rng.choice((And, Or, And, And, Implies, Iff))
+            parts = (_pattern(rng, s, operand), _pattern(rng, s, operand))
             f = op(parts) if op in (And, Or) else op(*parts)
+        elif kind < 0.85:
+            # Nested pairs: the decoding grammar allows two arguments per & (max_args).
+            p1, p2, p3 = (_pattern(rng, s, operand) for _ in range(3))
+            f = And((And((p1, p2)), p3))
         else:
             f = _random(rng, s, leaf, rng.randint(2, s.max_depth))
         if 1 <= depth(f) <= s.max_depth:
@@ -207,7 +236,9 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
         lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
     lifted = rename_atoms(f, lifted_names)
     lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
-    props: list[Proposition] = draw_propositions(rng, len(used))
+    now = atoms_read_now(f)
+    props: list[Proposition] = draw_propositions(
+        rng, len(used), conditions=frozenset(i for i, x in enumerate(used) if x in now))
     by_x = dict(zip(used, props, strict=True))
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}

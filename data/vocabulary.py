@@ -59,6 +59,11 @@ CONDITIONS = (
     ("path_blocked", ("the path is blocked",)), ("floor_wet", ("the floor is wet",)),
     ("human_request", ("a human asks for help", "a person requests help")),
 )
+#: Conditions about a place or an object: where the robot is, what it holds.
+PLACE_STATES = (("in", ("the robot is in the {x}", "you are in the {x}")),
+                ("person_in", ("a person is in the {x}", "someone is in the {x}")))
+OBJECT_STATES = (("holding", ("the robot is holding the {x}", "the {x} is in the gripper")),
+                 ("seen", ("the {x} is visible", "the robot sees the {x}")))
 
 
 @dataclass(frozen=True)
@@ -70,13 +75,33 @@ class Proposition:
     action: bool
 
 
-def draw_propositions(rng: random.Random, k: int) -> list[Proposition]:
-    """``k`` propositions with distinct names, mixing actions and conditions."""
+def draw_propositions(rng: random.Random, k: int,
+                      conditions: frozenset[int] = frozenset()) -> list[Proposition]:
+    """``k`` propositions with distinct names, mixing actions and conditions; the ones
+    at the indices in ``conditions`` are conditions."""
     found: dict[str, Proposition] = {}
-    while len(found) < k:
-        prop = _draw_one(rng)
-        found.setdefault(prop.name, prop)
-    return list(found.values())
+    order: list[str] = []
+    while len(order) < k:
+        prop = _draw_condition(rng) if len(order) in conditions else _draw_one(rng)
+        if prop.name not in found:
+            found[prop.name] = prop
+            order.append(prop.name)
+    return [found[name] for name in order]
+
+
+def _draw_condition(rng: random.Random) -> Proposition:
+    kind = rng.random()
+    if kind < 0.5:
+        name, phrases = rng.choice(CONDITIONS)
+        return Proposition(name, phrases, action=False)
+    if kind < 0.8:
+        verb, phrases = rng.choice(PLACE_STATES)
+        name, words = _thing(rng, PLACES, NUMBERED_PLACES)
+    else:
+        verb, phrases = rng.choice(OBJECT_STATES)
+        name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
+    return Proposition(f"{verb}_{name}", filled, action=False)
 
 
 def _draw_one(rng: random.Random) -> Proposition:

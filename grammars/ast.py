@@ -193,6 +193,16 @@ def atoms(node: Formula) -> frozenset[str]:
     return frozenset(n.name for n in walk(node) if isinstance(n, Atom))
 
 
+def atoms_read_now(node: Formula) -> frozenset[str]:
+    """The propositions ``node`` reads at its first instant only: those outside every
+    temporal operator (``a`` in ``a -> F(b)``, none in ``G(a)``)."""
+    if isinstance(node, Atom):
+        return frozenset({node.name})
+    if isinstance(node, (Eventually, Always, Until, Next)):
+        return frozenset()
+    return frozenset().union(*(atoms_read_now(c) for c in children(node)))
+
+
 def interval_of(node: Formula) -> Interval | None:
     """The node's interval, or ``None`` for untimed and non-temporal nodes."""
     return getattr(node, "interval", None)

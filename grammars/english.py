@@ -44,6 +44,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "F": ("eventually {a}", "at some point {a}", "{a} at some point", "sometime {a}",
           "{a} eventually", "make sure that eventually {a}", "sooner or later {a}",
           "finally {a}", "at some moment in the future {a}"),
+    # F over an action said as a command: "go to the kitchen" asks for it at some point.
+    "F_do": ("{a}", "make sure to {a}", "{a} at some point", "you have to {a}",
+             "please {a}", "{a} eventually", "at some point you should {a}",
+             "you need to {a}"),
     "F_n": ("within {n} {u}, {a}", "{a} within {n} {u}", "in the next {n} {u}, {a}",
             "{a} within the next {n} {u}", "no later than {s} {n}, {a}",
             "{a} in at most {n} {u}", "before {n} {u} have passed, {a}"),
@@ -64,7 +68,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "for each time instant in the next {lo} to {hi} {u}, {a}"),
     "never": ("never {a}", "at no time {a}", "{a} must never happen", "must not ever {a}",
               "always avoid {a}", "avoid {a} at all times", "it must never be the case that {a}",
-              "under no circumstances {a}"),
+              "under no circumstances {a}", "{a} is never allowed"),
     "never_n": ("never {a} in the first {n} {u}", "do not {a} during the first {n} {u}",
                 "avoid {a} for the next {n} {u}", "at no time in the next {n} {u}, {a}",
                 "{a} must not happen within {n} {u}"),
@@ -72,9 +76,11 @@ PHRASES: dict[str, tuple[str, ...]] = {
                  "at no time between {lo} and {hi} {u}, {a}"),
     "FG": ("eventually {a} forever", "eventually always {a}", "from some point on, always {a}",
            "sooner or later {a} for good", "{a} eventually holds forever",
-           "{a} from some point on, forever"),
+           "{a} from some point on, forever", "eventually {a} and from then on it stays so",
+           "in the end, {a} permanently"),
     "GF": ("{a} infinitely often", "{a} over and over again", "repeatedly {a}",
-           "always eventually {a}", "{a} again and again", "keep returning to {a} forever"),
+           "always eventually {a}", "{a} again and again", "keep returning to {a} forever",
+           "{a} periodically", "regularly {a}", "{a} time and again"),
     "response": ("whenever {a}, eventually {b}", "every time {a}, {b} at some later point",
                  "each time {a}, make sure that eventually {b}", "if ever {a}, then eventually {b}",
                  "{a} is always followed by {b}", "any time {a}, sooner or later {b}"),
@@ -83,16 +89,23 @@ PHRASES: dict[str, tuple[str, ...]] = {
                    "each time {a}, {b} in at most {n} {u}",
                    "whenever {a}, within {n} {u} {b}"),
     "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
-                  "at all times, if {a} then {b}", "always, if {a}, then {b}"),
+                  "at all times, if {a} then {b}", "always, if {a}, then {b}",
+                  "while {a}, {b}", "{b} while {a}", "as long as {a}, {b}",
+                  "{b} as long as {a}"),
     "sequence": ("first {a}, then {b}", "{a} and after that {b}", "{a}, and afterwards {b}",
-                 "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}"),
+                 "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}",
+                 "{a}, then {b}", "{a} first, and {b} afterwards", "after {a}, {b}",
+                 "{a}; once that is done, {b}"),
     "sequence3": ("first {a}, then {b}, then {c}", "{a}, then {b}, and finally {c}",
                   "{a}, after that {b}, and after that {c}", "{a}, then {b}, then {c}",
-                  "in this order: {a}, {b}, {c}"),
+                  "in this order: {a}, {b}, {c}", "{a}, {b}, and then {c}",
+                  "first {a}, next {b}, and last {c}", "{a}, afterwards {b}, then {c}"),
     "avoid_until": ("do not {a} until {b}", "{a} must not happen before {b}",
-                    "avoid {a} until {b}", "never {a} before {b}"),
+                    "avoid {a} until {b}", "never {a} before {b}",
+                    "wait until {b} before you {a}"),
     "U": ("{a} until {b}", "keep {a} until {b}", "{a} holds until {b}",
-          "{a} must hold until {b} happens", "continue {a} until {b}"),
+          "{a} must hold until {b} happens", "continue {a} until {b}",
+          "{a} up to the moment {b}"),
     "U_n": ("{a} until {b}, which must happen within {n} {u}",
             "keep {a} until {b} happens within {n} {u}", "{a} until {b} within the next {n} {u}"),
     "U_ab": ("{a} until {b} happens between {s} {lo} and {s} {hi}",
@@ -119,6 +132,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
 #: Phrasings only the compositional test split uses; training never sees them.
 HELD_OUT: dict[str, frozenset[str]] = {
     "F": frozenset({"at some moment in the future {a}"}),
+    "F_do": frozenset({"you need to {a}"}),
     "F_n": frozenset({"before {n} {u} have passed, {a}"}),
     "F_ab": frozenset({"at some time in the window from {lo} to {hi} {u}, {a}"}),
     "G": frozenset({"constantly {a}"}),
@@ -201,7 +215,7 @@ def explain(formula: Formula) -> str:
 
 def realize(formula: Formula, realizer: Realizer, used: list[str] | None = None) -> str:
     """One wording of ``formula``; ``used`` collects the ids of the phrasings used."""
-    text = _say(formula, realizer, used, embedded=False)
+    text = _say(formula, realizer, used, embedded=False, now=True)
     rng = realizer.rng
     if rng is not None:
         # "Prop_1" would be another proposition: never capitalize a name
@@ -212,7 +226,10 @@ def realize(formula: Formula, realizer: Realizer, used: list[str] | None = None)
     return text
 
 
-def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool) -> str:
+def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
+         now: bool = False) -> str:
+    """``now``: ``f`` is read at the first instant (outside every temporal operator),
+    where a bare command ("go to the kitchen") means "at some point"."""
     idiom = _idiom(f, r, used)
     if idiom is not None:
         return idiom
@@ -220,33 +237,39 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool) -> str
     def sub(g: Formula) -> str:
         return _say(g, r, used, embedded=True)
 
+    def sub_now(g: Formula) -> str:
+        return _say(g, r, used, embedded=True, now=now)
+
     if isinstance(f, Atom):
         return r.say_atom(f.name)
     if isinstance(f, Const):
         return r.pick("true" if f.value else "false", used)
     if isinstance(f, Not):
         act = isinstance(f.arg, Atom) and r.is_action(f.arg.name)
-        return r.pick("!act" if act else "!", used, a=sub(f.arg))
+        return r.pick("!act" if act else "!", used, a=sub_now(f.arg))
     if isinstance(f, Next):
         return f"at the next step {sub(f.arg)}"
+    if isinstance(f, Eventually) and now and f.interval is None and isinstance(f.arg, Atom) \
+            and r.is_action(f.arg.name):
+        return r.pick("F_do", used, a=sub(f.arg))
     if isinstance(f, (Eventually, Always)):
         op = "F" if isinstance(f, Eventually) else "G"
         return _timed(op, f.interval, r, used, a=sub(f.arg))
     if isinstance(f, (And, Or)):
         op = "&" if isinstance(f, And) else "|"
         key = op + "()" if embedded else op
-        text = sub(f.args[0])
+        text = sub_now(f.args[0])
         for arg in f.args[1:]:
             # A comma keeps "first a, then b, and never c" from reading as one sequence.
             comma = 3 if not embedded and " " in text else 0
-            text = r.pick(key, used, first=comma, a=text, b=sub(arg))
+            text = r.pick(key, used, first=comma, a=text, b=sub_now(arg))
         return text
     if isinstance(f, Until):
         if f.interval is None:
             return r.pick("U()" if embedded else "U", used, a=sub(f.lhs), b=sub(f.rhs))
         return _timed("U", f.interval, r, used, a=sub(f.lhs), b=sub(f.rhs))
     op = "->" if isinstance(f, Implies) else "<->"
-    return r.pick(op + "()" if embedded else op, used, a=sub(f.lhs), b=sub(f.rhs))
+    return r.pick(op + "()" if embedded else op, used, a=sub_now(f.lhs), b=sub_now(f.rhs))
 
 
 def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | None,
