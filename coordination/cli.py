@@ -39,20 +39,35 @@ def exp2_cmd(
                                   help="Helper objective: paper (D + T_help + T_new) or "
                                        "authors (T_all + D)."),
     ils_iterations: int = typer.Option(100, "--ils-iterations", help="Oracle ILS rounds."),
-    jobs: int = typer.Option(1, "--jobs", help="Parallel trials (joblib processes)."),
+    instances: str = typer.Option(
+        "paper", "--instances",
+        help="paper: trials drawn as the authors' code draws them (seeds 3000..3099 give "
+             "the paper's instances); uniform: this project's earlier generator."),
+    wait: str = typer.Option(
+        "arrival", "--wait",
+        help="When the requester's wait ends: arrival (the helper reaches the site, the "
+             "paper's count) or drop (the pallet is put down, one step later). "
+             "summary.json holds both."),
+    wordings: str = typer.Option(
+        "paper", "--wordings",
+        help="paper: every trial's request in the paper's words; all: trial i in wording "
+             "i mod 11 (the paper's and ten rewordings), to test a translator (--llm)."),
+    processes: int = typer.Option(1, "--processes",
+                                  help="Trials run in parallel (joblib processes)."),
 ) -> None:
     """Reproduce the paper's Experiment 2: trials.csv, summary.json, boxplot.png in OUT."""
     from ara.coordination.experiment2 import Exp2Config, run, table
 
     with user_errors():
         config = Exp2Config(trials=trials, seed=seed, planner=planner, llm=llm, solver=solver,
-                            objective=objective, ils_iterations=ils_iterations)
+                            objective=objective, ils_iterations=ils_iterations,
+                            instances=instances, wait=wait, wordings=wordings)
         if solver != "highs":
             from ara.coordination.milp import make_solver
 
             make_solver(solver)  # fails now, with its reason, rather than in a worker
         factory = (lambda: _translator(llm)) if llm != "none" else None
-        summary = run(config, out, jobs, factory)
+        summary = run(config, out, processes, factory)
     typer.echo(table(summary))
     typer.echo(json.dumps(summary["comparisons"], indent=2))
     typer.echo(f"wrote {out}/trials.csv, summary.json, boxplot.png")

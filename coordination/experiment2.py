@@ -1,11 +1,18 @@
 """The paper's Experiment 2: who should move the pallet, and what does it cost?
 
-Per trial (``../shared/specs/experiment2.md``; seeds 3000..3099): an 8x8 grid, a help
-site, 6 forklifts, 12 pick-and-place jobs, a makespan cap of 50. The exact Oracle
-schedules the 12 jobs once (S_orig); then each method places the help job and the
-metric is the time added to the system,
+Per trial (``../shared/specs/experiment2.md``; seeds 3000..3099, drawn as the
+authors' code draws them by default, see :mod:`ara.coordination.trials`): an 8x8 grid,
+a help site, 6 forklifts, 12 pick-and-place jobs, a makespan cap of 50. The exact
+Oracle schedules the 12 jobs once (S_orig); then each method places the help job and
+the metric is the time added to the system,
 
     Delta = (sum of makespans + the requester's wait, after) - (sum of makespans, before)
+
+The requester's wait ends when the helper arrives at the site (``arrival``, the
+paper's count) or when the pallet is dropped, one step later (``drop``). Every row
+holds both (``delta_arrival``, ``delta``); ``summary.json`` reports both, and the
+configured one first. Comparisons between methods use the trials where both are
+feasible.
 
 Methods: ``ours`` (the NL help protocol: every forklift bids, the requester takes the
 least tau_help + tau_new), ``oracle_ils`` (the paper's Oracle: greedy insertion +
@@ -23,7 +30,6 @@ from __future__ import annotations
 
 import csv
 import json
-import random
 import statistics
 import time
 from collections.abc import Sequence
@@ -32,19 +38,29 @@ from pathlib import Path
 
 from ara.coordination.milp import make_solver
 from ara.coordination.oracle import Fleet, ILSSettings, exact, ils
-from ara.coordination.planner_dp import Job
 from ara.coordination.protocol import (
+    REQUEST_WORDINGS,
     Helper,
     HelpRequest,
     choose,
     make_offer,
     request_text,
+    template_help_spec,
 )
-from ara.coordination.world import Cell, GridWorld
+from ara.coordination.trials import (
+    INSTANCES,
+    PAPER_WORLD,
+    Trial,
+    closest_robot,
+    make_trial,
+)
 from ara.errors import ConfigError
+from ara.stats import describe
 
 METHODS = ("ours", "oracle_ils", "oracle_exact", "b2", "b3")
 CAPABILITIES = ("navigate", "report conflicts")
+WAITS = ("arrival", "drop")
+WORDINGS = ("paper", "all")
 
 
 @dataclass(frozen=True)
@@ -61,6 +77,9 @@ class Exp2Config:
     llm: str = "none"
     solver: str = "highs"
     ils_iterations: int = 100
+    instances: str = "paper"
+    wait: str = "arrival"
+    wordings: str = "paper"
 
     def __post_init__(self) -> None:
         if (self.trials < 1 or self.robots < 1 or self.jobs < 0 or self.cap < 1
@@ -69,48 +88,17 @@ class Exp2Config:
                 "need trials >= 1, robots >= 1, jobs >= 0, cap >= 1 and ils_iterations >= 0; "
                 f"got {self.trials}, {self.robots}, {self.jobs}, {self.cap}, "
                 f"{self.ils_iterations}")
+        if self.instances not in INSTANCES:
+            raise ConfigError(f"--instances must be one of {INSTANCES}, got {self.instances!r}")
+        if self.wordings not in WORDINGS:
+            raise ConfigError(f"--wordings must be one of {WORDINGS}, got {self.wordings!r}")
+        if self.wait not in WAITS:
+            raise ConfigError(f"--wait must be one of {WAITS}, got {self.wait!r}")
         if self.planner not in ("dp", "milp"):
             raise ConfigError(f"--planner must be dp or milp, got {self.planner!r}")
         if self.llm != "none" and self.planner == "dp":
             raise ConfigError("a translated help request can say anything STL can: plan it "
                               "with --planner milp (the DP handles the template spec only)")
-
-
-@dataclass(frozen=True)
-class Trial:
-    """One random instance."""
-
-    index: int
-    seed: int
-    site: Cell
-    starts: tuple[Cell, ...]
-    jobs: tuple[Job, ...]
-
-    @property
-    def help_job(self) -> Job:
-        return Job(self.site, PAPER_WORLD.nearest_free_neighbour(self.site), name="help")
-
-
-PAPER_WORLD = GridWorld.paper()
-
-
-def make_trial(index: int, seed: int, robots: int = 6, jobs: int = 12,
-               world: GridWorld = PAPER_WORLD) -> Trial:
-    """The spec's draw: site, then starts (not on the site), then jobs, from one RNG."""
-    rng = random.Random(seed)
-    free = list(world.free_cells)
-    site = rng.choice(free)
-    others = [c for c in free if c != site]
-    starts = tuple(rng.choice(others) for _ in range(robots))
-    drawn = tuple(Job(rng.choice(free), rng.choice(free), name=f"j{k}") for k in range(jobs))
-    return Trial(index, seed, site, starts, drawn)
-
-
-def closest_robot(trial: Trial) -> int:
-    """The authors' "closest": Manhattan distance from the start cell, lowest id on ties."""
-    return min(range(len(trial.starts)),
-               key=lambda k: (abs(trial.starts[k][0] - trial.site[0])
-                              + abs(trial.starts[k][1] - trial.site[1]), k))
 
 
 def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
@@ -124,15 +112,20 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
         raise RuntimeError(f"trial {trial.index}: the 12-job schedule failed ({before.status})")
     rows = []
 
+    handover = trial.handover_steps
+
     def row(method: str, delta, helper=None, solve_s=0.0, **extra) -> None:
         rows.append({"trial": trial.index, "seed": trial.seed, "method": method,
-                     "delta": delta, "helper": helper, "solve_s": round(solve_s, 6),
+                     "delta": delta,
+                     "delta_arrival": None if delta is None else delta - handover,
+                     "helper": helper, "solve_s": round(solve_s, 6),
                      "feasible": delta is not None, **extra})
 
     helpers = [Helper(k, trial.starts[k], tuple(trial.jobs[j] for j in route))
                for k, route in enumerate(before.routes)]
+    wording = trial.index % len(REQUEST_WORDINGS) if config.wordings == "all" else 0
     request = HelpRequest("requester", trial.site, CAPABILITIES,
-                          request_text(trial.site, CAPABILITIES))
+                          request_text(trial.site, CAPABILITIES, wording=wording))
     options = {"planner": config.planner, "objective": config.objective, "cap": config.cap,
                "translator": translator, "solver": solver}
     offers, offer_s = [], []
@@ -147,6 +140,9 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
         o = offers[chosen]
         row("ours", o.bid, chosen, sum(offer_s), tau_help=o.tau_help, tau_new=o.tau_new,
             stl=o.stl)
+    if translator is not None:
+        rows[-1].update(wording=wording, **_against_template(
+            world, trial, request, helpers, offers, {**options, "translator": None}))
 
     # B2 is the nearest forklift's own offer, whether or not it won the auction
     near = closest_robot(trial)
@@ -171,6 +167,27 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
         r["before"] = before.cost
         r["before_s"] = round(before_s, 6)
     return rows
+
+
+def _against_template(world, trial: Trial, request: HelpRequest, helpers, offers,
+                      options) -> dict:
+    """What the helpers' translation did: whether it says the template's spec (Spot),
+    how many helpers declined, and the auction's Delta had they planned the template."""
+    from ara.grammars import parse
+    from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
+
+    stl = next((o.stl for o in offers if o.stl), None)
+    help_job = trial.help_job
+    try:
+        same = stl is not None and equivalent(
+            parse(stl), template_help_spec(help_job.pick, help_job.drop, ()), timeout_s=30)
+    except SpotTimeoutError:
+        same = None
+    template = [make_offer(world, h, request, **options) for h in helpers]
+    chosen = choose(template)
+    return {"template_equivalent": same,
+            "declined": sum(not o.can_help for o in offers),
+            "delta_template": None if chosen is None else template[chosen].bid}
 
 
 # -- the run --------------------------------------------------------------------------
@@ -204,7 +221,7 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     tmp.write_text("".join(json.dumps(r) + "\n" for r in done))
     tmp.replace(store)
     finished = {r["trial"] for r in done}
-    todo = [make_trial(i, config.seed + i, config.robots, config.jobs)
+    todo = [make_trial(i, config.seed + i, config.robots, config.jobs, config.instances)
             for i in range(config.trials) if i not in finished]
     from tqdm import tqdm
 
@@ -221,7 +238,7 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     write_csv(rows, out / "trials.csv")
     summary = summarize(rows, config)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    plot(rows, out / "boxplot.png")
+    plot(rows, out / "boxplot.png", config.wait)
     return summary
 
 
@@ -270,8 +287,9 @@ def _load_rows(path: Path) -> list[dict]:
     return [r for t, rs in complete.items() if len(rs) == len(METHODS) for r in rs]
 
 
-COLUMNS = ("trial", "seed", "method", "delta", "helper", "solve_s", "feasible", "before",
-           "tau_help", "tau_new", "wait", "stl", "reason")
+COLUMNS = ("trial", "seed", "method", "delta", "delta_arrival", "helper", "solve_s",
+           "feasible", "before", "tau_help", "tau_new", "wait", "stl", "reason", "wording",
+           "template_equivalent", "declined", "delta_template")
 
 
 def write_csv(rows: list[dict], path: Path) -> None:
@@ -282,51 +300,93 @@ def write_csv(rows: list[dict], path: Path) -> None:
             w.writerow(r)
 
 
-def _stats(values: list[float]) -> dict:
-    if not values:
-        return {"mean": None, "std": None, "median": None, "n": 0}
-    return {"mean": round(statistics.fmean(values), 4),
-            "std": round(statistics.stdev(values), 4) if len(values) > 1 else 0.0,
-            "median": statistics.median(values), "n": len(values)}
+def _delta_key(wait: str) -> str:
+    return "delta_arrival" if wait == "arrival" else "delta"
 
 
-def summarize(rows: list[dict], config: Exp2Config) -> dict:
-    """Per-method statistics of Delta over feasible trials, and the paper's ratios."""
-    methods = {}
+def _method_stats(rows: list[dict], wait: str) -> dict:
+    key, methods = _delta_key(wait), {}
     for m in METHODS:
         mine = [r for r in rows if r["method"] == m]
-        deltas = [r["delta"] for r in mine if r["delta"] is not None]
+        deltas = [r[key] for r in mine if r[key] is not None]
         times = [r["solve_s"] for r in mine]
-        methods[m] = {**_stats(deltas), "infeasible": len(mine) - len(deltas),
+        methods[m] = {**describe(deltas), "infeasible": len(mine) - len(deltas),
                       "solve_s": {"mean": round(statistics.fmean(times), 6) if times else None,
                                   "median": statistics.median(times) if times else None,
                                   "max": max(times, default=None)}}
-    ours = methods["ours"]["mean"]
+    return methods
 
-    def pct(num, den):
-        return None if num is None or den in (None, 0) else round(100 * num / den, 2)
 
-    comparisons = {}
-    if ours is not None:
-        for m in ("oracle_ils", "oracle_exact"):
-            ref = methods[m]["mean"]
-            comparisons[f"ours_vs_{m}"] = {
-                "value_pct": pct(None if ref is None else ours - ref, ours),
-                "formula": f"(ours - {m}) / ours, as the paper's 'within 18%'"}
-        for m in ("b2", "b3"):
-            ref = methods[m]["mean"]
-            comparisons[f"ours_better_than_{m}"] = {
-                "value_pct": pct(None if ref is None else ref - ours, ref),
-                "formula": f"({m} - ours) / {m}, over each method's feasible trials"}
+def _paired_means(rows: list[dict], wait: str, a: str, b: str) -> tuple[float, float, int]:
+    """Mean Delta of methods ``a`` and ``b`` over the trials where both are feasible."""
+    key = _delta_key(wait)
+    by = {(r["trial"], r["method"]): r[key] for r in rows}
+    trials = sorted({r["trial"] for r in rows})
+    pairs = [(by.get((t, a)), by.get((t, b))) for t in trials]
+    pairs = [(x, y) for x, y in pairs if x is not None and y is not None]
+    if not pairs:
+        return float("nan"), float("nan"), 0
+    return (statistics.fmean(x for x, _ in pairs), statistics.fmean(y for _, y in pairs),
+            len(pairs))
+
+
+def _comparisons(rows: list[dict], wait: str) -> dict:
+    """The paper's ratios, each over the trials where both methods are feasible."""
+    out = {}
+    for m, better in (("oracle_ils", False), ("oracle_exact", False), ("b2", True),
+                      ("b3", True)):
+        ours, ref, n = _paired_means(rows, wait, "ours", m)
+        if better:
+            name, value = f"ours_better_than_{m}", (ref - ours) / ref if n and ref else None
+            formula = f"({m} - ours) / {m}"
+        else:
+            name, value = f"ours_vs_{m}", (ours - ref) / ours if n and ours else None
+            formula = f"(ours - {m}) / ours, as the paper's 'within 18%'"
+        out[name] = {"value_pct": None if value is None else round(100 * value, 2),
+                     "trials": n, "formula": formula + ", on the trials where both are feasible"}
+    return out
+
+
+def _translation_summary(rows: list[dict]) -> dict:
+    """With an LLM: how often the helpers' formula was the template's, and what the
+    wrong ones did to the auction (its Delta against the template's, drop wait)."""
+    ours = [r for r in rows if r["method"] == "ours"]
+    wrong = [r for r in ours if r.get("template_equivalent") is not True]
+    changed = [r for r in wrong if r["delta"] != r.get("delta_template")]
+    by_wording: dict[int, list[int]] = {}
+    for r in ours:
+        by_wording.setdefault(r.get("wording", 0), [0, 0])
+        by_wording[r.get("wording", 0)][0] += r.get("template_equivalent") is True
+        by_wording[r.get("wording", 0)][1] += 1
+    return {"trials": len(ours), "equivalent_to_template": len(ours) - len(wrong),
+            "helpers_declined": sum(r.get("declined", 0) for r in ours),
+            "wrong_formula_trials": len(wrong),
+            "wrong_formula_changed_delta": len(changed),
+            "delta_change_when_changed": [
+                None if r["delta"] is None else r["delta"] - r["delta_template"]
+                for r in changed],
+            "by_wording": {str(w): {"equivalent": k, "trials": n}
+                           for w, (k, n) in sorted(by_wording.items())}}
+
+
+def summarize(rows: list[dict], config: Exp2Config) -> dict:
+    """Per-method statistics of Delta over feasible trials, with the requester's wait
+    counted both ways (``config.wait`` first), and the paper's ratios."""
+    by_wait = {w: {"methods": _method_stats(rows, w), "comparisons": _comparisons(rows, w)}
+               for w in WAITS}
+    chosen = by_wait[config.wait]
+    extra = {"translation": _translation_summary(rows)} if config.llm != "none" else {}
     return {"config": asdict(config), "trials": len({r["trial"] for r in rows}),
-            "methods": methods, "comparisons": comparisons,
-            "paper": {"oracle": 4.49, "ours": 5.47, "ours_better_than_b2_pct": 46,
-                      "ours_better_than_b3_pct": 53},
-            "replay_of_authors_code": {"oracle": 4.51, "ours": [5.26, 5.61], "b2": 7.98,
+            "wait": config.wait, "methods": chosen["methods"],
+            "comparisons": chosen["comparisons"], "by_wait": by_wait, **extra,
+            "paper": {"wait": "arrival", "oracle": 4.49, "ours": 5.47,
+                      "ours_better_than_b2_pct": 46, "ours_better_than_b3_pct": 53},
+            "replay_of_authors_code": {"wait": "arrival", "oracle": 4.51,
+                                       "ours": [5.26, 5.61], "b2": 7.98,
                                        "b3": [7.78, 8.63]}}
 
 
-def plot(rows: list[dict], path: Path) -> None:
+def plot(rows: list[dict], path: Path, wait: str = "arrival") -> None:
     """Box plot of Delta per method, like the paper's Fig. 4."""
     import matplotlib
 
@@ -335,12 +395,13 @@ def plot(rows: list[dict], path: Path) -> None:
 
     labels = {"ours": "Ours", "oracle_ils": "Oracle (ILS)", "oracle_exact": "Oracle (exact)",
               "b2": "B2 (nearest adds)", "b3": "B3 (nearest + re-opt.)"}
-    data = [[r["delta"] for r in rows if r["method"] == m and r["delta"] is not None]
+    key = _delta_key(wait)
+    data = [[r[key] for r in rows if r["method"] == m and r[key] is not None]
             for m in METHODS]
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.boxplot(data, showmeans=True)
     ax.set_xticks(range(1, len(METHODS) + 1), [labels[m] for m in METHODS], rotation=15)
-    ax.set_ylabel("time-steps added to the system (Delta)")
+    ax.set_ylabel(f"time-steps added to the system (Delta, wait until {wait})")
     n = len({r["trial"] for r in rows})
     ax.set_title(f"Experiment 2: {n} trials (mean as triangle)")
     fig.tight_layout()
@@ -349,11 +410,16 @@ def plot(rows: list[dict], path: Path) -> None:
 
 
 def table(summary: dict) -> str:
-    """A Markdown table of the summary beside the paper's and the replay's numbers."""
+    """A Markdown table of the summary beside the paper's and the replay's numbers
+    (both count the wait until the helper arrives)."""
     paper = {"ours": "5.47", "oracle_ils": "4.49", "oracle_exact": "", "b2": "", "b3": ""}
     replay = {"ours": "5.26-5.61", "oracle_ils": "4.51", "oracle_exact": "", "b2": "7.98",
               "b3": "7.78-8.63"}
-    lines = ["| method | mean Delta | std | median | n | infeasible | paper | replay |",
+    wait = summary.get("wait", "drop")
+    note = "" if wait == "arrival" else " (+1 to set beside ours: wait until drop)"
+    lines = [f"Delta with the requester's wait counted until {wait}; paper and authors' "
+             f"code count until arrival{note}.", "",
+             "| method | mean Delta | std | median | n | infeasible | paper | authors' code |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for m in METHODS:
         s = summary["methods"][m]
@@ -363,4 +429,3 @@ def table(summary: dict) -> str:
         lines.append(f"| {m} | {mean} | {std} | {med} | {s['n']} | {s['infeasible']} | "
                      f"{paper[m]} | {replay[m]} |")
     return "\n".join(lines)
-

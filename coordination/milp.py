@@ -16,7 +16,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from ara.errors import ConfigError
+from ara.errors import AraError, ConfigError
 
 INF = float("inf")
 STATUSES = ("optimal", "feasible", "infeasible", "time_limit", "error")
@@ -165,8 +165,19 @@ class HiGHSSolver:
                         dict(zip(model.names, x, strict=True)), gap, elapsed)
 
 
+#: gurobipy's error number for a model beyond the size-limited license that comes with
+#: the pip wheel (2,000 variables and 2,000 linear constraints).
+GUROBI_SIZE_LIMITED = 10010
+
+
+class SolverLicenseError(AraError, RuntimeError):
+    """The solver's license does not cover this model."""
+
+
 class GurobiSolver:
-    """Gurobi through ``gurobipy``; needs a license that covers the model's size."""
+    """Gurobi through ``gurobipy``. The pip wheel's bundled license solves models of up
+    to 2,000 variables and 2,000 constraints offline, which every model of Experiment 2
+    stays under; a larger one raises :class:`SolverLicenseError`."""
 
     name = "gurobi"
 
@@ -201,7 +212,13 @@ class GurobiSolver:
         start = time.perf_counter()
         try:
             m.optimize()
-        except gp.GurobiError as err:  # e.g. the size-limited pip license
+        except gp.GurobiError as err:
+            if err.errno == GUROBI_SIZE_LIMITED:
+                raise SolverLicenseError(
+                    f"this model has {len(xs)} variables and {m.NumConstrs} constraints, "
+                    "more than the size-limited Gurobi license of the pip wheel allows "
+                    "(2,000 each); use --solver highs, or install a full Gurobi "
+                    "license") from err
             return Solution("error", solve_s=time.perf_counter() - start, message=str(err))
         elapsed = time.perf_counter() - start
         G = gp.GRB

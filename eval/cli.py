@@ -17,6 +17,9 @@ eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
 MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lora:ADAPTER.gguf "
               "(another LoRA on the same base), a .gguf path, hf:FOLDER, or an "
               "OpenAI-compatible http(s):// endpoint")
+SERVER_HELP = ("With an http(s):// --model: the server that runs it, which says where it reads "
+               "the grammar for constrained decoding: llama (llama.cpp, llama-cpp-python), "
+               "vllm, sglang, or openai (no grammar; constrained variants are refused).")
 
 
 def translate_cmd(
@@ -49,6 +52,7 @@ def translate_cmd(
              "grouped by Spot equivalence; the largest group wins. 1: greedy."),
     temperature: float = typer.Option(0.7, "--temperature", min=0.01,
                                       help="Sampling temperature for --samples."),
+    server: str = typer.Option("openai", "--server", help=SERVER_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Translate one instruction into STL over the given propositions."""
@@ -69,7 +73,7 @@ def translate_cmd(
         k = shots if shots is not None else default_shots(model)
         pool = load_or_prepare("compositional").records("train", form_of(names))
         examples = sample_shots(pool, k, random.Random(seed)) if k else []
-        translator = Translator(make_backend(model), config)
+        translator = Translator(make_backend(model, server=server), config)
         vote = None
         if samples > 1:
             from ara.eval.consistency import translate_consistent
@@ -111,6 +115,7 @@ def ablation_cmd(
                                        help="Seconds per Spot check before 'undecided'."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
+    server: str = typer.Option("openai", "--server", help=SERVER_HELP),
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import run_ablation
@@ -126,7 +131,7 @@ def ablation_cmd(
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout,
         )
-        backend = make_backend(model, mask=mask)
+        backend = make_backend(model, mask=mask, server=server)
         try:
             results = run_ablation(config, backend, out, resume, progress=not no_progress)
         except KeyboardInterrupt:

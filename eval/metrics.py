@@ -20,12 +20,15 @@ from collections import defaultdict
 from collections.abc import Iterable
 from typing import TypedDict
 
+from ara.stats import describe
+
 
 class Stat(TypedDict):
-    """A metric over reruns, in percent (latency: milliseconds)."""
+    """A metric over reruns, in percent (latency: milliseconds); NaN when none."""
 
     mean: float
     std: float
+    median: float
     n: int
 
 
@@ -43,10 +46,7 @@ class VariantResult(TypedDict):
 
 
 def _stat(values: list[float]) -> Stat:
-    if not values:
-        return Stat(mean=float("nan"), std=float("nan"), n=0)
-    std = statistics.stdev(values) if len(values) > 1 else 0.0
-    return Stat(mean=round(statistics.fmean(values), 4), std=round(std, 4), n=len(values))
+    return Stat(**describe(values, empty=float("nan")))
 
 
 def _pct(k: int, n: int) -> float | None:

@@ -9,7 +9,8 @@
   12B on a bigger machine);
 * ``hf:DIR_OR_ID``: a Hugging Face model through transformers (local folder, or a hub id
   already in the local cache: nothing is downloaded);
-* ``http://...`` or ``https://...``: an OpenAI-compatible endpoint (unconstrained only).
+* ``http://...`` or ``https://...``: an OpenAI-compatible endpoint; constrained
+  decoding where ``server`` names a server that reads grammars (llama, vllm, sglang).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ def default_shots(model: str) -> int:
 
 
 def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
-                 api_model: str | None = None) -> Backend:
+                 api_model: str | None = None, server: str = "openai") -> Backend:
     """The backend for a ``--model`` value (see the module doc).
 
     Raises:
@@ -58,7 +59,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     if model.startswith(("http://", "https://")):
         from ara.eval.backends.openai_http import OpenAIBackend
 
-        return OpenAIBackend(model, api_model or "default")
+        return OpenAIBackend(model, api_model or "default", server=server)
     if model.startswith("hf:"):
         from ara.eval.backends.hf_backend import HFBackend
 

@@ -1,10 +1,24 @@
-"""An OpenAI-compatible HTTP endpoint: the paper's GPT-4 baseline, variants F and F+P.
+"""An OpenAI-compatible HTTP endpoint: a model served elsewhere (Gemma 3 12B on a GPU
+box), or the paper's GPT-4 baseline.
 
 Uses only the standard library. ``api="completions"`` sends the prompt as is (base
 models, llama.cpp's server); ``api="chat"`` sends it as one user message (GPT-4 and
 other chat models). The key, if the endpoint needs one, comes from
-``$OPENAI_API_KEY``. The endpoint decodes freely: constrained variants need a local
-backend, and asking this one for a grammar is an error, not a silent downgrade.
+``$OPENAI_API_KEY``.
+
+Constrained decoding (variant C) sends the request's own grammar in the field the
+server reads (:data:`GRAMMAR_FIELDS`), in GBNF, which llama.cpp reads natively and
+vLLM's and SGLang's grammar backends (xgrammar by default) read as EBNF:
+
+* ``llama``: llama.cpp's server and llama-cpp-python's, ``"grammar": GBNF``;
+* ``vllm``: ``"structured_outputs": {"grammar": GBNF}`` (vLLM >= 0.12; the older
+  ``guided_grammar`` was removed and unknown fields are silently ignored);
+* ``sglang``: ``"ebnf": GBNF``;
+* ``openai``: no grammar field; a constrained request is refused.
+
+A server that ignores the field answers 200 with free text. Every constrained answer
+is therefore checked against the grammar here, and one outside it stops the run with
+an error that says so, never a silent drop in validity.
 """
 
 from __future__ import annotations
@@ -18,6 +32,14 @@ import urllib.request
 from ara.eval.backends.base import BackendError, Completion, Sampling
 from ara.grammars import BuiltGrammar
 
+#: Where each server flavour reads a grammar; ``openai`` has none.
+GRAMMAR_FIELDS = {"llama": "grammar", "vllm": "structured_outputs.grammar",
+                  "sglang": "ebnf", "openai": None}
+#: What to upgrade or set when a flavour's server ignored the grammar.
+_FIX = {"llama": "a llama.cpp server (any recent build) or llama-cpp-python[server]",
+        "vllm": "vLLM >= 0.12 with a structured-outputs backend (xgrammar, guidance)",
+        "sglang": "SGLang with a grammar backend (xgrammar by default)"}
+
 
 class OpenAIBackend:
     """Completions from ``{base_url}/v1/completions`` or ``/v1/chat/completions``.
@@ -27,14 +49,18 @@ class OpenAIBackend:
         model: Model name the endpoint expects.
         api: ``completions`` or ``chat``.
         timeout_s: Seconds to wait for one answer.
+        server: The server's flavour, which says where it reads a grammar
+            (:data:`GRAMMAR_FIELDS`).
     """
 
     def __init__(self, base_url: str, model: str = "default", api: str = "completions",
-                 timeout_s: float = 120.0) -> None:
+                 timeout_s: float = 120.0, server: str = "openai") -> None:
         if api not in ("completions", "chat"):
             raise BackendError(f"api must be 'completions' or 'chat', got {api!r}")
+        if server not in GRAMMAR_FIELDS:
+            raise BackendError(f"server must be one of {sorted(GRAMMAR_FIELDS)}, got {server!r}")
         self.base_url = base_url.rstrip("/").removesuffix("/v1")
-        self.model, self.api, self.timeout_s = model, api, timeout_s
+        self.model, self.api, self.timeout_s, self.server = model, api, timeout_s, server
         self.model_id = f"http:{self.base_url}:{model}"
 
     def _post(self, path: str, body: dict) -> dict:
@@ -58,13 +84,8 @@ class OpenAIBackend:
                  stop: str, sampling: Sampling | None = None) -> Completion:
         if sampling is not None:
             raise BackendError("sampling (self-consistency) runs on local models only")
-        if grammar is not None:
-            raise BackendError(
-                "an HTTP endpoint decodes freely: run constrained variants (C) with a local "
-                "model (default, a .gguf path or hf:...)"
-            )
         body = {"model": self.model, "max_tokens": max_tokens, "temperature": 0.0,
-                "stop": [stop]}
+                "stop": [stop], **self.grammar_fields(grammar)}
         start = time.perf_counter()
         if self.api == "chat":
             answer = self._post("chat/completions",
@@ -75,7 +96,37 @@ class OpenAIBackend:
             text = answer["choices"][0]["text"]
         usage = answer.get("usage") or {}
         reason = answer["choices"][0].get("finish_reason")
+        if grammar is not None:
+            self._check_obeyed(grammar, text, stop)
         return Completion(text, usage.get("prompt_tokens", 0),
                           usage.get("completion_tokens", 0), 0,
                           (time.perf_counter() - start) * 1e3,
                           "length" if reason == "length" else "stop")
+
+    def grammar_fields(self, grammar: BuiltGrammar | None) -> dict:
+        """The request body's fields that carry ``grammar`` to this server flavour."""
+        if grammar is None:
+            return {}
+        where = GRAMMAR_FIELDS[self.server]
+        if where is None:
+            raise BackendError(
+                "this endpoint was named as plain OpenAI, which takes no grammar: name the "
+                "server that runs it (--server llama|vllm|sglang) for constrained variants "
+                "(C), or run them with a local model (default, a .gguf path or hf:...)")
+        gbnf = grammar.grammar.to_gbnf()
+        if "." in where:
+            outer, inner = where.split(".")
+            return {outer: {inner: gbnf}}
+        return {where: gbnf}
+
+    def _check_obeyed(self, grammar: BuiltGrammar, text: str, stop: str) -> None:
+        """That a constrained answer is in the grammar's language (the budget always
+        fits the grammar's longest string, so a cut answer is a disobeyed one too)."""
+        formula = text.removesuffix(stop)
+        if formula.startswith(" ") and grammar.syntax.accepts(formula[1:]):
+            return
+        raise BackendError(
+            f"the server at {self.base_url} ignored the grammar: it answered {text!r}, which "
+            f"the request's grammar does not admit. It was sent as "
+            f"{GRAMMAR_FIELDS[self.server]!r} for --server {self.server}; check that the "
+            f"server is {_FIX[self.server]}, and that --server names it")

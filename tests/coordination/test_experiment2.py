@@ -5,21 +5,37 @@ import json
 
 import pytest
 
-from ara.coordination.experiment2 import (
-    METHODS,
-    Exp2Config,
-    closest_robot,
-    make_trial,
-    run,
-    run_trial,
-)
+from ara.coordination.experiment2 import METHODS, Exp2Config, run, run_trial, table
+from ara.coordination.trials import closest_robot, make_trial
 from ara.errors import ConfigError
+
+
+@pytest.mark.parametrize(("seed", "site", "starts", "first_jobs", "last_job"), [
+    (3000, (6, 7), ((7, 0), (1, 0), (3, 1), (0, 5), (2, 7), (7, 5)),
+     [((5, 0), (0, 6)), ((2, 4), (5, 4))], ((7, 7), (1, 6))),
+    (3001, (3, 0), ((3, 1), (7, 4), (4, 6), (1, 2), (3, 5), (2, 4)),
+     [((2, 2), (2, 0)), ((3, 3), (5, 4))], ((7, 7), (7, 4))),
+    (3099, (0, 6), ((0, 7), (3, 7), (5, 2), (3, 7), (0, 7), (3, 3)),
+     [((0, 5), (4, 7)), ((3, 6), (7, 1))], ((5, 4), (3, 5))),
+])
+def test_paper_instances_are_pinned(seed, site, starts, first_jobs, last_job):
+    """Tests the authors' draw (re-seeded before the site, the starts and the jobs,
+    which come four picks then four drops at a time): any change to it moves these."""
+    t = make_trial(0, seed)
+    assert (t.site, t.starts) == (site, starts)
+    assert [(j.pick, j.drop) for j in t.jobs[:2]] == first_jobs
+    assert (t.jobs[-1].pick, t.jobs[-1].drop) == last_job
 
 
 def test_trials_are_the_specs_draw():
     t = make_trial(0, 3000)
     assert len(t.starts) == 6 and len(t.jobs) == 12 and t.site not in t.starts
     assert make_trial(0, 3000) == t and make_trial(1, 3001) != t
+    # the project's earlier generator, one unbroken stream, is still there
+    uniform = make_trial(0, 3000, instances="uniform")
+    assert uniform != t and uniform.site not in uniform.starts
+    with pytest.raises(ConfigError, match="instances must be one of"):
+        make_trial(0, 3000, instances="authors")
     near = closest_robot(t)
     assert all(abs(s[0] - t.site[0]) + abs(s[1] - t.site[1])
                >= abs(t.starts[near][0] - t.site[0]) + abs(t.starts[near][1] - t.site[1])
@@ -39,6 +55,18 @@ def test_methods_respect_what_each_can_know():
                 assert rows[m]["delta"] >= best, (seed, m)
         if rows["b2"]["delta"] is not None:
             assert rows["b3"]["delta"] <= rows["b2"]["delta"]
+
+
+def test_both_waits_are_counted_and_differ_by_the_handover_step():
+    """Tests the two waits: until the helper arrives (the paper's) and until the pallet
+    is dropped on the neighbouring cell, one step later, for every feasible method."""
+    config = Exp2Config(trials=1, ils_iterations=5)
+    rows = run_trial(make_trial(0, 3001), config)
+    for r in rows:
+        if r["feasible"]:
+            assert r["delta"] - r["delta_arrival"] == 1, r["method"]
+        else:
+            assert r["delta_arrival"] is None
 
 
 def test_run_writes_the_file_contract_and_resumes(tmp_path):
@@ -62,6 +90,15 @@ def test_run_writes_the_file_contract_and_resumes(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     for m in METHODS:
         assert set(summary["methods"][m]) >= {"mean", "std", "median", "n"}
+    assert summary["wait"] == "arrival"
+    assert summary["methods"] == summary["by_wait"]["arrival"]["methods"]
+    for m in METHODS:  # the paper's wait is one step shorter on every feasible trial
+        arrival, drop = (summary["by_wait"][w]["methods"][m] for w in ("arrival", "drop"))
+        if arrival["n"]:
+            assert drop["mean"] - arrival["mean"] == pytest.approx(1)
+    b2 = summary["comparisons"]["ours_better_than_b2"]
+    assert b2["trials"] <= 3 and "both are feasible" in b2["formula"]
+    assert "counted until arrival" in table(summary)
     assert (out / "boxplot.png").stat().st_size > 1000
     with pytest.raises(ConfigError, match="other settings"):
         run(Exp2Config(trials=4), out, progress=False)
@@ -85,17 +122,33 @@ def test_llm_requests_need_the_milp():
 def test_the_config_checks_its_ranges(bad):
     with pytest.raises(ConfigError, match="cap >= 1"):
         Exp2Config(**bad)
+    with pytest.raises(ConfigError, match="--wait must be one of"):
+        Exp2Config(wait="pick")
+    with pytest.raises(ConfigError, match="--instances must be one of"):
+        Exp2Config(instances="random")
+    with pytest.raises(ConfigError, match="--wordings must be one of"):
+        Exp2Config(wordings="some")
 
 
 def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
                                                                        llama_backend):
-    """Tests that run.json names the translator's model (file hashes), and that the
-    same folder refuses to continue with another model or none."""
+    """Tests that run.json names the translator's model (file hashes), that the same
+    folder refuses to continue with another model or none, and that each trial's
+    translation is judged against the template spec and the template's auction."""
     from ara.eval.translator import Translator
 
     out = tmp_path / "exp2-llm"
-    config = Exp2Config(trials=1, ils_iterations=5, llm="default", planner="milp")
-    run(config, out, translator_factory=lambda: Translator(llama_backend), progress=False)
+    config = Exp2Config(trials=2, ils_iterations=5, llm="default", planner="milp",
+                        wordings="all")
+    summary = run(config, out, translator_factory=lambda: Translator(llama_backend),
+                  progress=False)
+    ours = [json.loads(line) for line in (out / "trials.jsonl").read_text().splitlines()
+            if json.loads(line)["method"] == "ours"]
+    assert [r["wording"] for r in ours] == [0, 1]  # trial i in wording i mod 11
+    assert all(r["delta_template"] is not None and 0 <= r["declined"] <= 6 for r in ours)
+    seen = summary["translation"]
+    assert seen["trials"] == 2
+    assert seen["equivalent_to_template"] == sum(r["template_equivalent"] is True for r in ours)
     record = json.loads((out / "run.json").read_text())
     assert record["translator"] == llama_backend.model_id
     with pytest.raises(ConfigError, match="translator gguf:"):

@@ -5,7 +5,6 @@ import random
 
 import pytest
 
-from ara.coordination.experiment2 import make_trial
 from ara.coordination.oracle import (
     Fleet,
     FleetError,
@@ -16,6 +15,7 @@ from ara.coordination.oracle import (
     ils,
 )
 from ara.coordination.planner_dp import Job
+from ara.coordination.trials import make_trial
 from ara.coordination.world import GridWorld, WorldError
 from ara.errors import ConfigError
 

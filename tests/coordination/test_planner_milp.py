@@ -112,12 +112,11 @@ def test_solver_reports_infeasible_models_and_unknown_solvers():
 
 
 def test_gurobi_backend_finds_the_same_optima():
-    """The optional backend, where gurobipy is installed (its pip license covers
-    these models: a few hundred variables)."""
-    pytest.importorskip("gurobipy", reason="gurobipy not installed (pip install gurobipy)")
-    from ara.coordination.experiment2 import make_trial
+    """Tests Gurobi (installed by setup; the wheel's bundled license covers these
+    models, a few hundred variables) against HiGHS on the Oracle and the planner."""
     from ara.coordination.milp import GurobiSolver
     from ara.coordination.oracle import Fleet, exact
+    from ara.coordination.trials import make_trial
 
     trial = make_trial(0, 3000)
     fleet = Fleet(PAPER, trial.starts, (*trial.jobs, trial.help_job), help_job=12)
@@ -129,3 +128,16 @@ def test_gurobi_backend_finds_the_same_optima():
         a = plan_spec(PAPER, start, spec, vocab, "authors", solver=GurobiSolver())
         b = plan_spec(PAPER, start, spec, vocab, "authors", solver=HiGHSSolver())
         assert (a.status, a.objective, a.makespan) == (b.status, b.objective, b.makespan)
+
+
+def test_a_model_beyond_the_gurobi_pip_license_is_a_clear_error():
+    """Tests that 2,001 variables, one more than the wheel's license allows, stop with
+    an error that names the limit and the way out, not a silent failed solve."""
+    from ara.coordination.milp import GurobiSolver, LinearModel, SolverLicenseError
+
+    model = LinearModel()
+    names = [model.binary(f"x{i}", cost=1.0) for i in range(2001)]
+    model.row({name: 1.0 for name in names}, lo=3)
+    with pytest.raises(SolverLicenseError, match="2001 variables.*--solver highs"):
+        GurobiSolver().solve(model)
+    assert HiGHSSolver().solve(model).objective == 3

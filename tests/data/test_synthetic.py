@@ -16,7 +16,17 @@ from ara.data.synthetic import (
 )
 from ara.errors import ConfigError
 from ara.grammars import Syntax, parse
-from ara.grammars.ast import Always, Eventually, Iff, Implies, Not, Until, depth, walk
+from ara.grammars.ast import (
+    Always,
+    Eventually,
+    Iff,
+    Implies,
+    Not,
+    Until,
+    atoms_read_now,
+    depth,
+    walk,
+)
 
 
 @pytest.fixture(scope="module")
@@ -56,6 +66,21 @@ def test_lifted_and_grounded_records_of_a_row_share_their_shape(train_records):
         rows.setdefault(r.row, {})[r.form] = r
     for pair in rows.values():
         assert shape(pair["lifted"].formula) == shape(pair["grounded"].formula)
+
+
+ACTION_PREFIXES = ("go_to_", "visit_", "reach_", "enter_", "leave_", "at_", "pick_",
+                   "place_", "deliver_", "hold_", "inspect_", "charge", "wait", "beep",
+                   "report")
+
+
+def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
+    """Tests the grounded convention: an action outside every temporal operator would
+    say "do it now", which no user means by a command; such a place gets a condition
+    ("the door is open"), and commands sit under F, G or U."""
+    grounded = [r for r in train_records if r.form == "grounded"]
+    read_now = [name for r in grounded for name in atoms_read_now(r.formula)]
+    assert len(read_now) > 50  # conditions do occur there (if a then ..., a <-> ...)
+    assert not [name for name in read_now if name.startswith(ACTION_PREFIXES)]
 
 
 def test_held_out_shapes_stay_on_the_test_side(train_records):
@@ -105,6 +130,8 @@ def test_the_compositional_split_keeps_its_test_side_and_nl2tl_dev_out_of_traini
     assert {r.source for r in train} == {"navi", "nl2tl_timed_train", "synthetic",
                                          "help_request"}
     assert {r.source for r in test} == {"synthetic"}
+    # navi's grounded rows read a bare command as "holds now": not what users mean
+    assert not [r for r in train if r.source == "navi" and r.form == "grounded"]
     assert not {shape(r.formula) for r in test} & {shape(r.formula) for r in train}
     assert not {r.nl for r in test} & {r.nl for r in train}
     assert all(any(isinstance(n, k) for r in train for n in walk(r.formula))

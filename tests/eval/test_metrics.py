@@ -39,7 +39,8 @@ def test_reruns_give_mean_and_sample_std():
     samples = [sample("F", "a", True, True, rerun=0), sample("F", "b", True, True, rerun=0),
                sample("F", "a", True, True, rerun=1), sample("F", "b", False, rerun=1)]
     (r,) = score(samples)
-    assert r["validity"] == {"mean": 75.0, "std": pytest.approx(35.3553, abs=1e-3), "n": 2}
+    assert r["validity"] == {"mean": 75.0, "std": pytest.approx(35.3553, abs=1e-3),
+                             "median": 75.0, "n": 2}
 
 
 def test_undecided_spot_checks_are_counted_not_scored():

@@ -1,5 +1,6 @@
 """The HTTP backend against llama-cpp-python's real OpenAI-compatible server on loopback."""
 
+import os
 import socket
 import subprocess
 import sys
@@ -10,7 +11,7 @@ import pytest
 
 from ara.eval.backends.base import BackendError
 from ara.eval.backends.openai_http import OpenAIBackend
-from ara.eval.prompt import STOP, build_prompt
+from ara.eval.prompt import STOP, Shot, build_prompt
 from ara.eval.translator import Translator
 
 pytest.importorskip("uvicorn", reason="needs llama-cpp-python[server] (make setup)")
@@ -61,10 +62,98 @@ def test_translator_parses_the_endpoint_answer(server):
     assert result.raw.strip() and (result.valid or result.error)
 
 
-def test_constrained_requests_and_dead_endpoints_are_refused(server):
-    """Tests that C over HTTP is an error, and so is an endpoint nobody listens on."""
-    with pytest.raises(BackendError, match="decodes freely"):
+def test_constrained_decoding_on_the_server_equals_the_local_backend(server, llama_backend,
+                                                                      paper_split):
+    """Tests F+P+C over HTTP: the request's grammar travels in llama.cpp's field, every
+    answer is valid, and greedy answers equal the local llama.cpp backend's."""
+    records = paper_split.records("test", "lifted")[:6]
+    shots = [Shot.of(r) for r in paper_split.records("train", "lifted")[:3]]
+    remote = Translator(OpenAIBackend(server, server="llama"))
+    local = Translator(llama_backend)
+    for r in records:
+        there = remote.translate(r.nl, r.aps, shots, grammar_in_prompt=True)
+        here = local.translate(r.nl, r.aps, shots, grammar_in_prompt=True)
+        assert there.valid and there.grammar["grammar_sha256"]
+        assert there.stl == here.stl, r.nl
+
+
+def test_constrained_requests_to_plain_openai_and_dead_endpoints_are_refused(server):
+    """Tests that C needs a server that reads grammars, and that an endpoint nobody
+    listens on is an error."""
+    with pytest.raises(BackendError, match="--server llama"):
         Translator(OpenAIBackend(server)).translate("eventually (prop_1)", ["prop_1"])
     dead = OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5)
     with pytest.raises(BackendError, match="unreachable"):
         dead.complete("x", None, 4, STOP)
+
+
+def _decoding_grammar(aps=("prop_1", "prop_2")):
+    from ara.eval.translator import TranslatorConfig, decoding_grammar
+    from ara.grammars import build_grammar
+
+    return decoding_grammar(build_grammar(TranslatorConfig().syntax(aps, "no numbers")))
+
+
+@pytest.mark.parametrize(("flavour", "fields"), [
+    ("llama", lambda g: {"grammar": g}),
+    ("vllm", lambda g: {"structured_outputs": {"grammar": g}}),  # guided_grammar is gone
+    ("sglang", lambda g: {"ebnf": g}),
+])
+def test_each_server_gets_the_grammar_in_its_documented_field(flavour, fields):
+    """Tests the request bodies against the servers' documented field names, with the
+    request's own GBNF (vLLM and SGLang cannot run on these machines)."""
+    grammar = _decoding_grammar()
+    backend = OpenAIBackend("http://127.0.0.1:9", server=flavour)
+    assert backend.grammar_fields(grammar) == fields(grammar.grammar.to_gbnf())
+    assert backend.grammar_fields(None) == {}
+    with pytest.raises(BackendError, match="server must be one of"):
+        OpenAIBackend("http://127.0.0.1:9", server="tgi")
+
+
+@pytest.fixture()
+def deaf_server():
+    """A real HTTP server on loopback that answers like a vLLM which ignores unknown
+    fields: 200 and free text, whatever grammar it was sent."""
+    import json
+    import threading
+    from http.server import BaseHTTPRequestHandler, HTTPServer
+
+    class Handler(BaseHTTPRequestHandler):
+        def do_POST(self):  # noqa: N802 (the stdlib's name)
+            self.rfile.read(int(self.headers["Content-Length"]))
+            body = json.dumps({"choices": [{"text": " eventually prop_1 holds",
+                                            "finish_reason": "stop"}]}).encode()
+            self.send_response(200)
+            self.send_header("Content-Type", "application/json")
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    httpd = HTTPServer(("127.0.0.1", 0), Handler)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    httpd.shutdown()
+
+
+def test_a_server_that_ignores_the_grammar_stops_the_run(deaf_server):
+    """Tests that free text from a server that dropped the grammar field is an error
+    naming the field and what to check, not a silently invalid answer."""
+    translator = Translator(OpenAIBackend(deaf_server, server="vllm"))
+    with pytest.raises(BackendError, match="ignored the grammar.*structured_outputs"):
+        translator.translate("eventually (prop_1)", ["prop_1"])
+
+
+@pytest.mark.skipif(not os.environ.get("ARA_TEST_SERVER_URL"),
+                    reason="set ARA_TEST_SERVER_URL (and ARA_TEST_SERVER=llama|vllm|sglang) "
+                           "to a running server to test it live")
+def test_a_live_server_decodes_under_the_grammar():
+    """Tests constrained translation against a server you run (e.g. vLLM with Gemma 3
+    12B): the answer is a formula over the request's propositions."""
+    backend = OpenAIBackend(os.environ["ARA_TEST_SERVER_URL"],
+                            os.environ.get("ARA_TEST_SERVER_MODEL", "default"),
+                            server=os.environ.get("ARA_TEST_SERVER", "llama"))
+    result = Translator(backend).translate("always avoid (prop_1) and eventually reach "
+                                           "(prop_2)", ["prop_1", "prop_2"])
+    assert result.valid and result.constrained

@@ -3,7 +3,7 @@
 import pytest
 
 from ara.grammars import And, Atom, Eventually, Interval, Not, Or, Until, atoms, depth, max_bound
-from ara.grammars.ast import ASTError, rename_atoms
+from ara.grammars.ast import ASTError, atoms_read_now, rename_atoms
 
 
 @pytest.mark.parametrize(
@@ -31,6 +31,19 @@ def test_helpers_read_the_tree():
     assert atoms(f) == {"a", "b"}
     assert depth(f) == 3
     assert max_bound(f) == 9
+
+
+@pytest.mark.parametrize(("formula", "now"), [
+    ("a -> F(b)", {"a"}),
+    ("G(a -> b)", set()),
+    ("(a & !b) | (c U d)", {"a", "b"}),
+    ("F(a) <-> b", {"b"}),
+])
+def test_atoms_read_now_are_those_outside_every_temporal_operator(formula, now):
+    """Tests which propositions a formula reads at its first instant only."""
+    from ara.grammars import parse
+
+    assert atoms_read_now(parse(formula)) == now
 
 
 def test_rename_atoms_keeps_structure_and_intervals():

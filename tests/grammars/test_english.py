@@ -79,6 +79,20 @@ def test_train_mode_never_uses_a_held_out_phrasing():
     assert held & set(used_test)
 
 
+def test_a_command_said_on_its_own_means_at_some_point():
+    """Tests that F(action) at the first instant reads as the bare command or another
+    "at some point" wording, and that under another operator it never reads bare."""
+    said = {"go": "go to the kitchen", "door": "the door is open"}
+    realizer = Realizer(rng=random.Random(0), mode="train", say_atom=said.__getitem__,
+                        is_action=lambda name: name == "go")
+    top = {realize(parse("door -> F(go)"), realizer) for _ in range(200)}
+    commands = {p.format(a="go to the kitchen") for p in PHRASES["F_do"]}
+    assert any(s.rstrip(".").endswith("then go to the kitchen") for s in top)
+    assert all(any(c in s.lower() for c in commands) for s in top)
+    nested = {realize(parse("G(F(go))"), realizer).rstrip(".").lower() for _ in range(100)}
+    assert "go to the kitchen" not in nested
+
+
 def test_realizer_settings_are_checked():
     """Tests that a bad mode or unit is refused where the realizer is built."""
     with pytest.raises(ConfigError, match="mode must be one of"):
