@@ -23,7 +23,6 @@ from ara.coordination.oracle import Fleet, exact
 from ara.coordination.protocol import Helper, HelpRequest, make_offer, request_text
 from ara.coordination.trials import PAPER_WORLD, make_trial
 
-
 PLANNERS = {"dp": ("dp", "highs"), "milp-highs": ("milp", "highs"),
             "milp-gurobi": ("milp", "gurobi")}
 

@@ -264,13 +264,19 @@ def _perturb(routes: list[list[int]], rng: random.Random, moves: int,
 
 
 def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int] | None = None,
-          time_limit_s: float = 60.0) -> Schedule:
+          time_limit_s: float = 60.0, canonical: bool = True) -> Schedule:
     """The optimum by MILP: job successions, completion times, MTZ order.
 
     ``x[k,j]``: robot k does j first; ``y[i,j]``: j right after i. Every job has one
     predecessor; each robot and job at most one successor. ``c[j] >= c[i] + leg`` on
     chosen successions bounds completion times (the cap bounds them all); the sum of
     chosen legs is the sum of makespans, and ``c[help]`` the requester's wait.
+
+    An instance often has several optimal schedules, and solvers return different ones;
+    the decentralized methods then start from different plans. With ``canonical`` a
+    second solve keeps the optimum and picks, among the optimal schedules, the one of
+    least fixed pseudo-random arc weights, so that HiGHS and Gurobi return the same
+    schedule (checked on the paper's instances).
     """
     first, then = fleet.legs
     n, robots = len(fleet.jobs), len(fleet.starts)
@@ -326,9 +332,12 @@ def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int]
                 m.ge({f"r[{j}]": 1, f"r[{i}]": -1, y: -robots}, -robots)
     for j, k in pinned.items():
         m.row({f"r[{j}]": 1}, k, k)
-    solution = (solver or make_solver()).solve(m, time_limit_s)
+    solver = solver or make_solver()
+    solution = solver.solve(m, time_limit_s)
     if not solution.has_solution:
         return Schedule((), (), 0, 0, False, solution.status, solution.solve_s)
+    if canonical and solution.status == "optimal":
+        solution = _canonical(m, solution, solver, time_limit_s)
     v = solution.values
     routes = []
     for k in range(robots):
@@ -341,3 +350,21 @@ def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int]
     return Schedule(schedule.routes, schedule.makespans, schedule.help_time, schedule.cost,
                     schedule.feasible, solution.status, solution.solve_s,
                     {"gap": solution.gap, **m.size})
+
+
+def _canonical(m: LinearModel, first, solver: MILPSolver, time_limit_s: float):
+    """The optimal schedule of least fixed arc weights (seeded, 1..999 per successor
+    arc); ``first`` where the second solve does not prove its optimum."""
+    objective = {i: c for i, c in enumerate(m.cost) if c}
+    # Costs are integers (legs and waits), so the optimum is a bound with no tolerance
+    m.le({m.names[i]: c for i, c in objective.items()}, round(first.objective))
+    weights = random.Random(0)
+    m.cost = [0.0] * len(m.names)
+    for i, name in enumerate(m.names):
+        if name.startswith(("x[", "y[")):
+            m.cost[i] = float(weights.randint(1, 999))
+    second = solver.solve(m, time_limit_s)
+    if second.status != "optimal":
+        return first
+    return type(second)(second.status, first.objective, second.values, second.gap,
+                        first.solve_s + second.solve_s)

@@ -2,25 +2,37 @@
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from tqdm import tqdm
 
 from ara.data import load_or_prepare
+from ara.errors import ConfigError
 from ara.eval.backends.base import Backend
-from ara.eval.harness import AblationConfig, plan, run_job, run_metadata
+from ara.eval.harness import AblationConfig, plan, run_metadata, sample_of, translate_job
 from ara.eval.report import Results, write_report
 from ara.eval.run_store import RunStore
 from ara.eval.translator import Translator
 
 
 def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bool = False,
-                 progress: bool = True) -> Results:
+                 progress: bool = True, concurrency: int = 1) -> Results:
     """Run (or continue) ``config`` with ``backend`` into ``out`` and write its report.
 
     Interrupting (Ctrl-C, SIGTERM via the CLI) keeps every finished sample; the
     report is written from whatever is on disk, and ``resume=True`` continues.
+
+    With ``concurrency`` > 1 (remote backends only: the server batches the requests)
+    that many generations are in flight at once; samples are still judged and written
+    one at a time in the planned order, so the log, resume and the no-duplicate rule
+    are those of a serial run.
     """
+    if concurrency < 1:
+        raise ConfigError(f"--concurrency must be >= 1, got {concurrency}")
+    if concurrency > 1 and not getattr(backend, "concurrent", False):
+        raise ConfigError("--concurrency > 1 needs a remote backend (--model http://...): a "
+                          "local model generates one answer at a time")
     split = load_or_prepare(config.split, config.data_seed)
     meta = run_metadata(config, split, backend.model_id)
     translator = Translator(backend, config.translator)
@@ -30,15 +42,22 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
         bar = tqdm(total=len(jobs), initial=len(jobs) - len(todo), disable=not progress,
                    desc="translating", unit="formula", dynamic_ncols=True)
         valid = 0
+        pool = ThreadPoolExecutor(concurrency) if concurrency > 1 else None
         try:
-            for i, job in enumerate(todo, 1):
-                sample = run_job(translator, job, config.spot_timeout_s)
+            if pool is None:
+                results = (translate_job(translator, job) for job in todo)
+            else:  # in order, as they finish in order
+                results = pool.map(lambda job: translate_job(translator, job), todo)
+            for i, (job, result) in enumerate(zip(todo, results, strict=True), 1):
+                sample = sample_of(job, result, config.spot_timeout_s)
                 store.append(sample)
                 valid += sample["valid"]
                 bar.set_postfix(variant=job.variant.name, shots=job.shots,
                                 valid=f"{100 * valid / i:.0f}%", refresh=False)
                 bar.update()
         finally:
+            if pool is not None:  # answers in flight are dropped, and asked again on resume
+                pool.shutdown(wait=False, cancel_futures=True)
             bar.close()
             results = write_report(out)
     return results

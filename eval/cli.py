@@ -116,6 +116,10 @@ def ablation_cmd(
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
     server: str = typer.Option("openai", "--server", help=SERVER_HELP),
+    concurrency: int = typer.Option(
+        1, "--concurrency",
+        help="Requests in flight at once, for an http(s):// --model (the server batches "
+             "them); samples are still written in order, and --resume works as usual."),
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import run_ablation
@@ -133,7 +137,8 @@ def ablation_cmd(
         )
         backend = make_backend(model, mask=mask, server=server)
         try:
-            results = run_ablation(config, backend, out, resume, progress=not no_progress)
+            results = run_ablation(config, backend, out, resume, progress=not no_progress,
+                                   concurrency=concurrency)
         except KeyboardInterrupt:
             typer.echo(f"interrupted: finished samples are in {out}; continue with --resume",
                        err=True)

@@ -21,7 +21,7 @@ from ara.data import PreparedSplit, Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
 from ara.eval.prompt import Shot, sample_shots
-from ara.eval.translator import Translator, TranslatorConfig
+from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
 from ara.provenance import git_commit
@@ -197,11 +197,16 @@ def judge(reference: str, output: str | None, timeout_s: float) -> dict:
         return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
-def run_job(translator: Translator, job: Job, timeout_s: float) -> dict:
-    """Translate one test pair and judge it: one line of samples.jsonl."""
+def translate_job(translator: Translator, job: Job) -> TranslationResult:
+    """The generation of one job (what may run concurrently against a server)."""
     r = job.record
-    result = translator.translate(r.nl, r.aps, job.examples, job.variant.grammar_in_prompt,
-                                  job.variant.constrained)
+    return translator.translate(r.nl, r.aps, job.examples, job.variant.grammar_in_prompt,
+                                job.variant.constrained)
+
+
+def sample_of(job: Job, result: TranslationResult, timeout_s: float) -> dict:
+    """One line of samples.jsonl: the job, its translation and Spot's verdicts."""
+    r = job.record
     return {
         "variant": job.variant.name, "shots": job.shots, "rerun": job.rerun, "uid": r.uid,
         "nl": r.nl, "aps": list(r.aps), "reference": r.stl, "raw": result.raw,

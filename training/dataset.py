@@ -109,7 +109,16 @@ def shared_prefix_length(batch: dict[str, torch.Tensor]) -> int:
 
 
 def answer_loss(model, batch: dict[str, torch.Tensor], share_prefix: bool = True) -> torch.Tensor:
-    """Mean cross-entropy over answer tokens, computing the vocabulary head only there.
+    """Mean cross-entropy over answer tokens (see :func:`answer_loss_sum`)."""
+    total, count = answer_loss_sum(model, batch, share_prefix)
+    return total / count
+
+
+def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = True
+                    ) -> tuple[torch.Tensor, int]:
+    """Summed cross-entropy over answer tokens, and their number, computing the
+    vocabulary head only there. Several processes sharing one batch add their sums and
+    counts, so that their loss is the single-process mean over the whole batch.
 
     Gemma's output layer (262k x hidden) costs more than the rest of a 270M model; the
     logits at position t predict token t+1, so only the positions right before an
@@ -135,5 +144,7 @@ def answer_loss(model, batch: dict[str, torch.Tensor], share_prefix: bool = True
         out = model(input_ids=ids[:, shared:], attention_mask=mask, past_key_values=cache,
                     logits_to_keep=keep - shared)
     logits = out.logits  # (batch, len(keep), vocab)
-    return torch.nn.functional.cross_entropy(
-        logits.float().reshape(-1, logits.shape[-1]), gathered.reshape(-1), ignore_index=IGNORE)
+    total = torch.nn.functional.cross_entropy(
+        logits.float().reshape(-1, logits.shape[-1]), gathered.reshape(-1), ignore_index=IGNORE,
+        reduction="sum")
+    return total, int((gathered != IGNORE).sum())

@@ -24,7 +24,7 @@ from ara import __version__
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
 from ara.training.dataset import (
-    answer_loss,
+    answer_loss_sum,
     batch_shots,
     batches,
     collate,
@@ -79,10 +79,11 @@ class LoRAFinetuneRecipe:
             model, optimizer, scheduler)
         if self.resume:
             self._load_checkpoint()
-        else:
+        elif self.accelerator.is_main_process:
             self.out.mkdir(parents=True, exist_ok=True)
             self.out.joinpath("run.json").write_text(json.dumps(self._provenance(), indent=2,
                                                                 sort_keys=True) + "\n")
+        self.accelerator.wait_for_everyone()
 
     def _base_model_dir(self) -> str:
         if self.config.base_model == "default":
@@ -129,6 +130,7 @@ class LoRAFinetuneRecipe:
                 "data": {"split": self.config.data.split, "version": self.split.version,
                          "train_examples": len(self.train_records)},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
+                "processes": self.accelerator.num_processes,
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
 
@@ -136,10 +138,15 @@ class LoRAFinetuneRecipe:
     def train(self) -> list[float]:
         """Run the optimizer steps left; returns the loss of each step taken."""
         cfg, pad = self.config, self.tokenizer.pad_token_id or 0
+        acc = self.accelerator
+        # With several processes each takes its share of every batch (batch_size is the
+        # global batch); their summed losses over the batch's answer tokens make the same
+        # loss, and the same gradient, as one process with the whole batch.
+        world, rank = acc.num_processes, acc.process_index
         losses: list[float] = []
         bar = tqdm(total=self.total_steps, initial=self.step, desc="training", unit="step",
-                   disable=not self.accelerator.is_main_process, dynamic_ncols=True)
-        log = open(self.out / "train_log.jsonl", "a")
+                   disable=not acc.is_main_process, dynamic_ncols=True)
+        log = open(self.out / "train_log.jsonl", "a") if acc.is_main_process else None
         self.model.train()
         # One optimizer step spans grad_accum micro-batches: its log line sums their
         # time and tokens and averages their losses.
@@ -156,31 +163,41 @@ class LoRAFinetuneRecipe:
                         start = time.perf_counter()
                     shots = self._shots(micro, epoch, index)
                     examples = encode(micro, self.tokenizer, shots)
-                    batch = {k: v.to(self.accelerator.device)
-                             for k, v in collate(examples, pad).items()}
-                    with self.accelerator.accumulate(self.model):
-                        loss = answer_loss(self.model, batch)
-                        self.accelerator.backward(loss)
+                    # A process left without rows (a short last batch) runs one row at
+                    # weight 0, so that every process meets in the gradient exchange.
+                    mine = examples[rank::world]
+                    weight = 1.0 if mine else 0.0
+                    batch = {k: v.to(acc.device)
+                             for k, v in collate(mine or examples[:1], pad).items()}
+                    with acc.accumulate(self.model):
+                        total, count = answer_loss_sum(self.model, batch)
+                        total = total * weight
+                        counted = acc.reduce(torch.tensor(float(count * weight),
+                                                          device=acc.device), "sum")
+                        # DDP averages gradients over processes: scale back to the sum
+                        acc.backward(total * world / counted)
                         self.optimizer.step()
                         self.scheduler.step()
                         self.optimizer.zero_grad()
-                    micro_losses.append(loss.item())
+                    micro_losses.append(float(acc.reduce(total.detach(), "sum") / counted))
                     micro_shots.append(len(shots))
-                    tokens += int(batch["attention_mask"].sum())
-                    if not self.accelerator.sync_gradients:
+                    tokens += int(acc.reduce(batch["attention_mask"].sum() * int(weight),
+                                             "sum"))
+                    if not acc.sync_gradients:
                         continue
                     self.step += 1
                     losses.append(sum(micro_losses) / len(micro_losses))
                     seconds = time.perf_counter() - start
                     rate = tokens / seconds
-                    log.write(json.dumps({"step": self.step, "epoch": epoch,
-                                          "loss": round(losses[-1], 5),
-                                          "lr": self.scheduler.get_last_lr()[0],
-                                          "shots": (micro_shots[0] if len(micro_shots) == 1
-                                                    else micro_shots),
-                                          "tokens_per_s": round(rate, 1),
-                                          "seconds": round(seconds, 2)}) + "\n")
-                    log.flush()
+                    if log is not None:
+                        log.write(json.dumps({"step": self.step, "epoch": epoch,
+                                              "loss": round(losses[-1], 5),
+                                              "lr": self.scheduler.get_last_lr()[0],
+                                              "shots": (micro_shots[0] if len(micro_shots) == 1
+                                                        else micro_shots),
+                                              "tokens_per_s": round(rate, 1),
+                                              "seconds": round(seconds, 2)}) + "\n")
+                        log.flush()
                     micro_losses, micro_shots, tokens = [], [], 0
                     bar.set_postfix(loss=f"{losses[-1]:.3f}", tok_s=f"{rate:.0f}", refresh=False)
                     bar.update()
@@ -190,7 +207,8 @@ class LoRAFinetuneRecipe:
                         break
         finally:
             bar.close()
-            log.close()
+            if log is not None:
+                log.close()
         return losses
 
     def _shots(self, micro, epoch: int, index: int):
@@ -203,7 +221,9 @@ class LoRAFinetuneRecipe:
         """Adapter, optimizer, scheduler and RNG state at the current step."""
         folder = self.out / "checkpoints" / f"step_{self.step}"
         self.accelerator.save_state(str(folder))
-        folder.joinpath("step.json").write_text(json.dumps({"step": self.step}))
+        if self.accelerator.is_main_process:
+            folder.joinpath("step.json").write_text(json.dumps({"step": self.step}))
+        self.accelerator.wait_for_everyone()
         return folder
 
     def _load_checkpoint(self) -> None:
@@ -289,9 +309,11 @@ def main(config_path: str, max_steps: int | None = None, resume: bool = False) -
     recipe.setup()
     losses = recipe.train()
     recipe.save_checkpoint()
-    summary = {"steps": recipe.step, "adapter": str(recipe.save_adapter()),
-               "first_loss": losses[0] if losses else None,
+    summary = {"steps": recipe.step, "first_loss": losses[0] if losses else None,
                "last_loss": losses[-1] if losses else None}
-    if config.eval_pairs:
-        summary["heldout"] = recipe.heldout_check()
+    if recipe.accelerator.is_main_process:  # one adapter and one check, whatever the processes
+        summary["adapter"] = str(recipe.save_adapter())
+        if config.eval_pairs:
+            summary["heldout"] = recipe.heldout_check()
+    recipe.accelerator.wait_for_everyone()
     return summary

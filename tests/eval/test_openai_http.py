@@ -66,9 +66,10 @@ def test_constrained_decoding_on_the_server_equals_the_local_backend(server, lla
                                                                       paper_split):
     """Tests F+P+C over HTTP: the request's grammar travels in llama.cpp's field, every
     answer is valid, and greedy answers equal the local llama.cpp backend's."""
-    records = paper_split.records("test", "lifted")[:6]
+    records = paper_split.records("test", "lifted")[:3]
     shots = [Shot.of(r) for r in paper_split.records("train", "lifted")[:3]]
-    remote = Translator(OpenAIBackend(server, server="llama"))
+    # llama.cpp's grammar sampler checks the whole vocabulary at each step: seconds
+    remote = Translator(OpenAIBackend(server, server="llama", timeout_s=900))
     local = Translator(llama_backend)
     for r in records:
         there = remote.translate(r.nl, r.aps, shots, grammar_in_prompt=True)
@@ -157,3 +158,30 @@ def test_a_live_server_decodes_under_the_grammar():
     result = Translator(backend).translate("always avoid (prop_1) and eventually reach "
                                            "(prop_2)", ["prop_1", "prop_2"])
     assert result.valid and result.constrained
+
+
+def test_concurrent_requests_keep_the_serial_log(server, tmp_path, llama_backend):
+    """Tests --concurrency: with three requests in flight the samples are the serial
+    run's, in the same order, a resumed run adds none twice, and a local backend
+    refuses concurrency."""
+    from ara.errors import ConfigError
+    from ara.eval.ablation import run_ablation
+    from ara.eval.harness import AblationConfig
+    from ara.eval.run_store import read_samples
+
+    config = AblationConfig(variants=("F", "C"), shots=(2,), reruns=1, limit=3,
+                            spot_timeout_s=5)
+    backend = OpenAIBackend(server, server="llama", timeout_s=900)
+    run_ablation(config, backend, tmp_path / "serial", progress=False)
+    run_ablation(config, backend, tmp_path / "parallel", progress=False, concurrency=3)
+
+    def answers(folder):
+        return [(s["variant"], s["uid"], s["raw"]) for s in read_samples(folder)]
+
+    assert answers(tmp_path / "parallel") == answers(tmp_path / "serial")
+    assert len(answers(tmp_path / "serial")) == 6
+    run_ablation(config, backend, tmp_path / "parallel", resume=True, progress=False,
+                 concurrency=3)
+    assert len(answers(tmp_path / "parallel")) == 6
+    with pytest.raises(ConfigError, match="needs a remote backend"):
+        run_ablation(config, llama_backend, tmp_path / "local", progress=False, concurrency=2)
