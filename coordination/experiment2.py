@@ -23,19 +23,33 @@ job and the exact Oracle re-optimizes everything else).
 
 Each finished trial is appended to ``trials.jsonl`` at once, so an interrupted run
 resumes where it stopped; ``trials.csv``, ``summary.json`` and ``boxplot.png`` are
-written from it at the end.
+written from it at the end (:mod:`ara.coordination.exp2_report`). The settings are
+:class:`~ara.coordination.exp2_config.Exp2Config`, the instances
+:mod:`ara.coordination.trials`.
 """
 
 from __future__ import annotations
 
-import csv
 import json
-import statistics
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 
+from ara.coordination.exp2_config import (  # noqa: F401 (the experiment's public names)
+    CAPABILITIES,
+    METHODS,
+    WAITS,
+    WORDINGS,
+    Exp2Config,
+)
+from ara.coordination.exp2_report import (  # noqa: F401
+    COLUMNS,
+    plot,
+    summarize,
+    table,
+    write_csv,
+)
 from ara.coordination.milp import make_solver
 from ara.coordination.oracle import Fleet, ILSSettings, exact, ils
 from ara.coordination.protocol import (
@@ -47,58 +61,8 @@ from ara.coordination.protocol import (
     request_text,
     template_help_spec,
 )
-from ara.coordination.trials import (
-    INSTANCES,
-    PAPER_WORLD,
-    Trial,
-    closest_robot,
-    make_trial,
-)
+from ara.coordination.trials import PAPER_WORLD, Trial, closest_robot, make_trial
 from ara.errors import ConfigError
-from ara.stats import describe
-
-METHODS = ("ours", "oracle_ils", "oracle_exact", "b2", "b3")
-CAPABILITIES = ("navigate", "report conflicts")
-WAITS = ("arrival", "drop")
-WORDINGS = ("paper", "all")
-
-
-@dataclass(frozen=True)
-class Exp2Config:
-    """One experiment's settings (recorded in ``run.json``)."""
-
-    trials: int = 100
-    seed: int = 3000
-    robots: int = 6
-    jobs: int = 12
-    cap: int = 50
-    planner: str = "dp"
-    objective: str = "paper"
-    llm: str = "none"
-    solver: str = "highs"
-    ils_iterations: int = 100
-    instances: str = "paper"
-    wait: str = "arrival"
-    wordings: str = "paper"
-
-    def __post_init__(self) -> None:
-        if (self.trials < 1 or self.robots < 1 or self.jobs < 0 or self.cap < 1
-                or self.ils_iterations < 0):
-            raise ConfigError(
-                "need trials >= 1, robots >= 1, jobs >= 0, cap >= 1 and ils_iterations >= 0; "
-                f"got {self.trials}, {self.robots}, {self.jobs}, {self.cap}, "
-                f"{self.ils_iterations}")
-        if self.instances not in INSTANCES:
-            raise ConfigError(f"--instances must be one of {INSTANCES}, got {self.instances!r}")
-        if self.wordings not in WORDINGS:
-            raise ConfigError(f"--wordings must be one of {WORDINGS}, got {self.wordings!r}")
-        if self.wait not in WAITS:
-            raise ConfigError(f"--wait must be one of {WAITS}, got {self.wait!r}")
-        if self.planner not in ("dp", "milp"):
-            raise ConfigError(f"--planner must be dp or milp, got {self.planner!r}")
-        if self.llm != "none" and self.planner == "dp":
-            raise ConfigError("a translated help request can say anything STL can: plan it "
-                              "with --planner milp (the DP handles the template spec only)")
 
 
 def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
@@ -287,145 +251,3 @@ def _load_rows(path: Path) -> list[dict]:
     return [r for t, rs in complete.items() if len(rs) == len(METHODS) for r in rs]
 
 
-COLUMNS = ("trial", "seed", "method", "delta", "delta_arrival", "helper", "solve_s",
-           "feasible", "before", "tau_help", "tau_new", "wait", "stl", "reason", "wording",
-           "template_equivalent", "declined", "delta_template")
-
-
-def write_csv(rows: list[dict], path: Path) -> None:
-    with path.open("w", newline="") as f:
-        w = csv.DictWriter(f, COLUMNS, extrasaction="ignore")
-        w.writeheader()
-        for r in sorted(rows, key=lambda r: (r["trial"], METHODS.index(r["method"]))):
-            w.writerow(r)
-
-
-def _delta_key(wait: str) -> str:
-    return "delta_arrival" if wait == "arrival" else "delta"
-
-
-def _method_stats(rows: list[dict], wait: str) -> dict:
-    key, methods = _delta_key(wait), {}
-    for m in METHODS:
-        mine = [r for r in rows if r["method"] == m]
-        deltas = [r[key] for r in mine if r[key] is not None]
-        times = [r["solve_s"] for r in mine]
-        methods[m] = {**describe(deltas), "infeasible": len(mine) - len(deltas),
-                      "solve_s": {"mean": round(statistics.fmean(times), 6) if times else None,
-                                  "median": statistics.median(times) if times else None,
-                                  "max": max(times, default=None)}}
-    return methods
-
-
-def _paired_means(rows: list[dict], wait: str, a: str, b: str) -> tuple[float, float, int]:
-    """Mean Delta of methods ``a`` and ``b`` over the trials where both are feasible."""
-    key = _delta_key(wait)
-    by = {(r["trial"], r["method"]): r[key] for r in rows}
-    trials = sorted({r["trial"] for r in rows})
-    pairs = [(by.get((t, a)), by.get((t, b))) for t in trials]
-    pairs = [(x, y) for x, y in pairs if x is not None and y is not None]
-    if not pairs:
-        return float("nan"), float("nan"), 0
-    return (statistics.fmean(x for x, _ in pairs), statistics.fmean(y for _, y in pairs),
-            len(pairs))
-
-
-def _comparisons(rows: list[dict], wait: str) -> dict:
-    """The paper's ratios, each over the trials where both methods are feasible."""
-    out = {}
-    for m, better in (("oracle_ils", False), ("oracle_exact", False), ("b2", True),
-                      ("b3", True)):
-        ours, ref, n = _paired_means(rows, wait, "ours", m)
-        if better:
-            name, value = f"ours_better_than_{m}", (ref - ours) / ref if n and ref else None
-            formula = f"({m} - ours) / {m}"
-        else:
-            name, value = f"ours_vs_{m}", (ours - ref) / ours if n and ours else None
-            formula = f"(ours - {m}) / ours, as the paper's 'within 18%'"
-        out[name] = {"value_pct": None if value is None else round(100 * value, 2),
-                     "trials": n, "formula": formula + ", on the trials where both are feasible"}
-    return out
-
-
-def _translation_summary(rows: list[dict]) -> dict:
-    """With an LLM: how often the helpers' formula was the template's, and what the
-    wrong ones did to the auction (its Delta against the template's, drop wait)."""
-    ours = [r for r in rows if r["method"] == "ours"]
-    wrong = [r for r in ours if r.get("template_equivalent") is not True]
-    changed = [r for r in wrong if r["delta"] != r.get("delta_template")]
-    by_wording: dict[int, list[int]] = {}
-    for r in ours:
-        by_wording.setdefault(r.get("wording", 0), [0, 0])
-        by_wording[r.get("wording", 0)][0] += r.get("template_equivalent") is True
-        by_wording[r.get("wording", 0)][1] += 1
-    return {"trials": len(ours), "equivalent_to_template": len(ours) - len(wrong),
-            "helpers_declined": sum(r.get("declined", 0) for r in ours),
-            "wrong_formula_trials": len(wrong),
-            "wrong_formula_changed_delta": len(changed),
-            "delta_change_when_changed": [
-                None if r["delta"] is None else r["delta"] - r["delta_template"]
-                for r in changed],
-            "by_wording": {str(w): {"equivalent": k, "trials": n}
-                           for w, (k, n) in sorted(by_wording.items())}}
-
-
-def summarize(rows: list[dict], config: Exp2Config) -> dict:
-    """Per-method statistics of Delta over feasible trials, with the requester's wait
-    counted both ways (``config.wait`` first), and the paper's ratios."""
-    by_wait = {w: {"methods": _method_stats(rows, w), "comparisons": _comparisons(rows, w)}
-               for w in WAITS}
-    chosen = by_wait[config.wait]
-    extra = {"translation": _translation_summary(rows)} if config.llm != "none" else {}
-    return {"config": asdict(config), "trials": len({r["trial"] for r in rows}),
-            "wait": config.wait, "methods": chosen["methods"],
-            "comparisons": chosen["comparisons"], "by_wait": by_wait, **extra,
-            "paper": {"wait": "arrival", "oracle": 4.49, "ours": 5.47,
-                      "ours_better_than_b2_pct": 46, "ours_better_than_b3_pct": 53},
-            "replay_of_authors_code": {"wait": "arrival", "oracle": 4.51,
-                                       "ours": [5.26, 5.61], "b2": 7.98,
-                                       "b3": [7.78, 8.63]}}
-
-
-def plot(rows: list[dict], path: Path, wait: str = "arrival") -> None:
-    """Box plot of Delta per method, like the paper's Fig. 4."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    labels = {"ours": "Ours", "oracle_ils": "Oracle (ILS)", "oracle_exact": "Oracle (exact)",
-              "b2": "B2 (nearest adds)", "b3": "B3 (nearest + re-opt.)"}
-    key = _delta_key(wait)
-    data = [[r[key] for r in rows if r["method"] == m and r[key] is not None]
-            for m in METHODS]
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.boxplot(data, showmeans=True)
-    ax.set_xticks(range(1, len(METHODS) + 1), [labels[m] for m in METHODS], rotation=15)
-    ax.set_ylabel(f"time-steps added to the system (Delta, wait until {wait})")
-    n = len({r["trial"] for r in rows})
-    ax.set_title(f"Experiment 2: {n} trials (mean as triangle)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def table(summary: dict) -> str:
-    """A Markdown table of the summary beside the paper's and the replay's numbers
-    (both count the wait until the helper arrives)."""
-    paper = {"ours": "5.47", "oracle_ils": "4.49", "oracle_exact": "", "b2": "", "b3": ""}
-    replay = {"ours": "5.26-5.61", "oracle_ils": "4.51", "oracle_exact": "", "b2": "7.98",
-              "b3": "7.78-8.63"}
-    wait = summary.get("wait", "drop")
-    note = "" if wait == "arrival" else " (+1 to set beside ours: wait until drop)"
-    lines = [f"Delta with the requester's wait counted until {wait}; paper and authors' "
-             f"code count until arrival{note}.", "",
-             "| method | mean Delta | std | median | n | infeasible | paper | authors' code |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|"]
-    for m in METHODS:
-        s = summary["methods"][m]
-        mean = "-" if s["mean"] is None else f"{s['mean']:.2f}"
-        std = "-" if s["std"] is None else f"{s['std']:.2f}"
-        med = "-" if s["median"] is None else f"{s['median']:g}"
-        lines.append(f"| {m} | {mean} | {std} | {med} | {s['n']} | {s['infeasible']} | "
-                     f"{paper[m]} | {replay[m]} |")
-    return "\n".join(lines)

@@ -27,7 +27,8 @@ MODELS = {
     "base-270m": ("base", None),
     "paper-adapter-270m": ("paper adapter (old)", "paper"),
     "compositional-adapter-v1-270m": ("compositional adapter v1", "compositional"),
-    "compositional-adapter-270m": ("compositional adapter v2 (shipped)", "compositional"),
+    "compositional-adapter-v2-270m": ("compositional adapter v2", "compositional"),
+    "compositional-adapter-270m": ("compositional adapter v3 (shipped)", "compositional"),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),

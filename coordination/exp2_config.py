@@ -1,0 +1,52 @@
+"""Experiment 2's settings: what a run is (recorded in ``run.json``, and a resumed run
+must be the same)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ara.coordination.trials import INSTANCES
+from ara.errors import ConfigError
+
+METHODS = ("ours", "oracle_ils", "oracle_exact", "b2", "b3")
+CAPABILITIES = ("navigate", "report conflicts")
+WAITS = ("arrival", "drop")
+WORDINGS = ("paper", "all")
+
+
+@dataclass(frozen=True)
+class Exp2Config:
+    """One experiment's settings (recorded in ``run.json``)."""
+
+    trials: int = 100
+    seed: int = 3000
+    robots: int = 6
+    jobs: int = 12
+    cap: int = 50
+    planner: str = "dp"
+    objective: str = "paper"
+    llm: str = "none"
+    solver: str = "highs"
+    ils_iterations: int = 100
+    instances: str = "paper"
+    wait: str = "arrival"
+    wordings: str = "paper"
+
+    def __post_init__(self) -> None:
+        if (self.trials < 1 or self.robots < 1 or self.jobs < 0 or self.cap < 1
+                or self.ils_iterations < 0):
+            raise ConfigError(
+                "need trials >= 1, robots >= 1, jobs >= 0, cap >= 1 and ils_iterations >= 0; "
+                f"got {self.trials}, {self.robots}, {self.jobs}, {self.cap}, "
+                f"{self.ils_iterations}")
+        if self.instances not in INSTANCES:
+            raise ConfigError(f"--instances must be one of {INSTANCES}, got {self.instances!r}")
+        if self.wordings not in WORDINGS:
+            raise ConfigError(f"--wordings must be one of {WORDINGS}, got {self.wordings!r}")
+        if self.wait not in WAITS:
+            raise ConfigError(f"--wait must be one of {WAITS}, got {self.wait!r}")
+        if self.planner not in ("dp", "milp"):
+            raise ConfigError(f"--planner must be dp or milp, got {self.planner!r}")
+        if self.llm != "none" and self.planner == "dp":
+            raise ConfigError("a translated help request can say anything STL can: plan it "
+                              "with --planner milp (the DP handles the template spec only)")
