@@ -29,7 +29,7 @@ def finetuned(embedded_model_path):
 
 
 @pytest.mark.parametrize(("adapter", "version"), [
-    (FINETUNED_LORA, "c3c2564014d2"),  # the registered compositional mixture
+    (FINETUNED_LORA, "2cc898a81b54"),  # the registered compositional mixture
     (PAPER_LORA, "1de1d813ead6"),  # the registered paper split
 ])
 def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
@@ -75,13 +75,15 @@ def test_an_untimed_sentence_comes_out_untimed(finetuned):
 
 def test_finetuned_translates_paper_pairs_with_and_without_worked_examples(finetuned,
                                                                           paper_split):
-    """On grounded paper-split test pairs: zero-shot, and with 5 worked examples from the
-    compositional train side (variant F+C), most answers are right."""
+    """On lifted paper-split test pairs: zero-shot, and with 5 worked examples from the
+    compositional train side (variant F+C), most answers are right. (The grounded side
+    reads a bare command as holding now, navi's convention, which the shipped adapter
+    deliberately does not follow.)"""
     from ara.data import load_or_prepare
     from ara.eval.prompt import sample_shots
 
-    pairs = [(r.nl, r.aps, r.stl) for r in paper_split.records("test", "grounded")[:12]]
-    shots = sample_shots(load_or_prepare("compositional").records("train", "grounded"), 5,
+    pairs = [(r.nl, r.aps, r.stl) for r in paper_split.records("test", "lifted")[:12]]
+    shots = sample_shots(load_or_prepare("compositional").records("train", "lifted"), 5,
                          random.Random(0))
     zero, five = correct(finetuned, pairs), correct(finetuned, pairs, shots)
     assert zero >= 10 and five >= 10, (zero, five)

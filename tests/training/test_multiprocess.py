@@ -1,4 +1,4 @@
-"""Data-parallel training for real: two processes (gloo, CPU) through `accelerate launch`."""
+"""Data-parallel training for real: two processes (gloo, CPU) launched by torchrun."""
 
 import json
 import os
@@ -18,11 +18,20 @@ def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
     return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
 
 
-def _train(command: list[str], config: dict, folder) -> tuple[list[float], int]:
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _train(command: list[str], config: dict, folder, **env_extra) -> tuple[list[float], int]:
     folder.mkdir()
     path = folder / "config.yaml"
     path.write_text(yaml.safe_dump({**config, "out": str(folder / "run")}))
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "TOKENIZERS_PARALLELISM": "false"}
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "TOKENIZERS_PARALLELISM": "false",
+           **env_extra}
     done = subprocess.run([*command, "train", "--config", str(path)], env=env,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
@@ -32,19 +41,20 @@ def _train(command: list[str], config: dict, folder) -> tuple[list[float], int]:
 
 
 def test_two_processes_train_like_one_with_the_same_global_batch(tiny_gemma_dir, tmp_path):
-    """Tests the multi-GPU path on CPUs: `accelerate launch --cpu --num_processes 2`
-    splits each batch of 4 between two processes (gloo), which log one line per step
-    whose losses equal a single process's on the whole batch, step after step."""
+    """Tests the multi-GPU path on CPUs: two processes (torchrun, gloo) split each batch
+    of 4, log one line per step, and their losses equal a single process's on the
+    whole batch, step after step."""
     config = {"base_model": tiny_gemma_dir, "seed": 0, "checkpoint_every": 100,
               "eval_pairs": 0, "max_steps": 3,
               "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
               "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0, "epochs": 2},
               "data": {"forms": ["lifted"], "limit": 8, "shots": [0, 2]}}
     single, one = _train([sys.executable, "-m", "ara.cli"], config, tmp_path / "one")
-    launcher = [sys.executable, "-m", "accelerate.commands.launch", "--cpu",
-                "--num_processes", "2", "--num_machines", "1", "--mixed_precision", "no",
-                "--dynamo_backend", "no", "-m", "ara.cli"]
-    double, two = _train(launcher, config, tmp_path / "two")
+    # torchrun starts the two processes (accelerate's own launcher runs one with --cpu);
+    # with ACCELERATE_USE_CPU, Accelerator() finds WORLD_SIZE=2 and takes gloo
+    launcher = [sys.executable, "-m", "torch.distributed.run", "--nproc_per_node", "2",
+                "--master_port", str(_free_port()), "-m", "ara.cli"]
+    double, two = _train(launcher, config, tmp_path / "two", ACCELERATE_USE_CPU="true")
     assert (one, two) == (1, 2)
     assert len(single) == len(double) == 3
     assert double == pytest.approx(single, rel=2e-3)
