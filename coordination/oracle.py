@@ -19,7 +19,7 @@ import math
 import random
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 from ara.coordination.milp import LinearModel, MILPSolver, make_solver
@@ -366,5 +366,4 @@ def _canonical(m: LinearModel, first, solver: MILPSolver, time_limit_s: float):
     second = solver.solve(m, time_limit_s)
     if second.status != "optimal":
         return first
-    return type(second)(second.status, first.objective, second.values, second.gap,
-                        first.solve_s + second.solve_s)
+    return replace(second, objective=first.objective, solve_s=first.solve_s + second.solve_s)

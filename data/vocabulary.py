@@ -80,13 +80,10 @@ def draw_propositions(rng: random.Random, k: int,
     """``k`` propositions with distinct names, mixing actions and conditions; the ones
     at the indices in ``conditions`` are conditions."""
     found: dict[str, Proposition] = {}
-    order: list[str] = []
-    while len(order) < k:
-        prop = _draw_condition(rng) if len(order) in conditions else _draw_one(rng)
-        if prop.name not in found:
-            found[prop.name] = prop
-            order.append(prop.name)
-    return [found[name] for name in order]
+    while len(found) < k:
+        prop = _draw_condition(rng) if len(found) in conditions else _draw_one(rng)
+        found.setdefault(prop.name, prop)
+    return list(found.values())
 
 
 def _draw_condition(rng: random.Random) -> Proposition:
@@ -100,8 +97,7 @@ def _draw_condition(rng: random.Random) -> Proposition:
     else:
         verb, phrases = rng.choice(OBJECT_STATES)
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
-    filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
-    return Proposition(f"{verb}_{name}", filled, action=False)
+    return _about(verb, phrases, name, words, action=False)
 
 
 def _draw_one(rng: random.Random) -> Proposition:
@@ -118,8 +114,14 @@ def _draw_one(rng: random.Random) -> Proposition:
     else:
         name, phrases = rng.choice(CONDITIONS)
         return Proposition(name, phrases, action=False)
+    return _about(verb, phrases, name, words, action=True)
+
+
+def _about(verb: str, phrases: tuple[str, ...], name: str, words: str,
+           action: bool) -> Proposition:
+    """``verb_name``, said by each phrasing with the thing's words filled in."""
     filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
-    return Proposition(f"{verb}_{name}", filled, action=True)
+    return Proposition(f"{verb}_{name}", filled, action)
 
 
 def _thing(rng: random.Random, plain, numbered) -> tuple[str, str]:

@@ -45,10 +45,10 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
         pool = ThreadPoolExecutor(concurrency) if concurrency > 1 else None
         try:
             if pool is None:
-                results = (translate_job(translator, job) for job in todo)
-            else:  # in order, as they finish in order
-                results = pool.map(lambda job: translate_job(translator, job), todo)
-            for i, (job, result) in enumerate(zip(todo, results, strict=True), 1):
+                answers = (translate_job(translator, job) for job in todo)
+            else:  # in the planned order, whatever order they finish in
+                answers = pool.map(lambda job: translate_job(translator, job), todo)
+            for i, (job, result) in enumerate(zip(todo, answers, strict=True), 1):
                 sample = sample_of(job, result, config.spot_timeout_s)
                 store.append(sample)
                 valid += sample["valid"]

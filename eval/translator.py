@@ -174,6 +174,12 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
 
 
 @lru_cache(maxsize=1024)
+def admits(built: BuiltGrammar, raw: str) -> bool:
+    """Whether ``raw`` (stop string removed) is what decoding under ``built`` may
+    produce: the answer prefix and a formula of the language."""
+    return raw.startswith(ANSWER_PREFIX) and built.syntax.accepts(raw[len(ANSWER_PREFIX):])
+
+
 def decoding_grammar(built: BuiltGrammar) -> BuiltGrammar:
     """The grammar decoding runs under: the answer prefix, a formula of ``built``, and the
     newline that ends an answer (see :meth:`Grammar.with_suffix`)."""
@@ -245,7 +251,7 @@ class Translator:
     @staticmethod
     def _check_guarantee(built: BuiltGrammar, raw: str, stop: str) -> None:
         """A constrained answer is ' ' + a string of the language; anything else is a bug."""
-        if not raw.startswith(ANSWER_PREFIX) or not built.syntax.accepts(raw[1:]):
+        if not admits(built, raw):
             raise AssertionError(
                 f"constrained decoding produced {raw!r} (stop={stop}), which the grammar does "
                 "not admit; this is a bug in the backend's constraint, please report it"

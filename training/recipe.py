@@ -162,27 +162,27 @@ class LoRAFinetuneRecipe:
                     if not micro_losses:
                         start = time.perf_counter()
                     shots = self._shots(micro, epoch, index)
-                    examples = encode(micro, self.tokenizer, shots)
                     # A process left without rows (a short last batch) runs one row at
                     # weight 0, so that every process meets in the gradient exchange.
-                    mine = examples[rank::world]
+                    mine = micro[rank::world]
                     weight = 1.0 if mine else 0.0
-                    batch = {k: v.to(acc.device)
-                             for k, v in collate(mine or examples[:1], pad).items()}
+                    examples = encode(mine or micro[:1], self.tokenizer, shots)
+                    batch = {k: v.to(acc.device) for k, v in collate(examples, pad).items()}
                     with acc.accumulate(self.model):
                         total, count = answer_loss_sum(self.model, batch)
-                        total = total * weight
-                        counted = acc.reduce(torch.tensor(float(count * weight),
-                                                          device=acc.device), "sum")
+                        # One exchange per micro-batch: the batch's loss sum, its answer
+                        # tokens and all its tokens, over every process.
+                        loss_sum, counted, batch_tokens = acc.reduce(weight * torch.stack([
+                            total.detach(), total.new_tensor(float(count)),
+                            batch["attention_mask"].sum().to(total)]), "sum")
                         # DDP averages gradients over processes: scale back to the sum
-                        acc.backward(total * world / counted)
+                        acc.backward(total * weight * world / counted)
                         self.optimizer.step()
                         self.scheduler.step()
                         self.optimizer.zero_grad()
-                    micro_losses.append(float(acc.reduce(total.detach(), "sum") / counted))
+                    micro_losses.append(float(loss_sum / counted))
                     micro_shots.append(len(shots))
-                    tokens += int(acc.reduce(batch["attention_mask"].sum() * int(weight),
-                                             "sum"))
+                    tokens += int(batch_tokens)
                     if not acc.sync_gradients:
                         continue
                     self.step += 1

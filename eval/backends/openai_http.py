@@ -125,8 +125,9 @@ class OpenAIBackend:
     def _check_obeyed(self, grammar: BuiltGrammar, text: str, stop: str) -> None:
         """That a constrained answer is in the grammar's language (the budget always
         fits the grammar's longest string, so a cut answer is a disobeyed one too)."""
-        formula = text.removesuffix(stop)
-        if formula.startswith(" ") and grammar.syntax.accepts(formula[1:]):
+        from ara.eval.translator import admits
+
+        if admits(grammar, text.removesuffix(stop)):
             return
         raise BackendError(
             f"the server at {self.base_url} ignored the grammar: it answered {text!r}, which "
