@@ -80,16 +80,17 @@ def _translation_summary(rows: list[dict]) -> dict:
     changed = [r for r in wrong if r["delta"] != r.get("delta_template")]
     by_wording: dict[int, list[int]] = {}
     for r in ours:
-        by_wording.setdefault(r.get("wording", 0), [0, 0])
-        by_wording[r.get("wording", 0)][0] += r.get("template_equivalent") is True
-        by_wording[r.get("wording", 0)][1] += 1
+        tally = by_wording.setdefault(r.get("wording", 0), [0, 0])
+        tally[0] += r.get("template_equivalent") is True
+        tally[1] += 1
     return {"trials": len(ours), "equivalent_to_template": len(ours) - len(wrong),
             "helpers_declined": sum(r.get("declined", 0) for r in ours),
             "wrong_formula_trials": len(wrong),
             "wrong_formula_changed_delta": len(changed),
+            # None where either auction found no helper
             "delta_change_when_changed": [
-                None if r["delta"] is None else r["delta"] - r["delta_template"]
-                for r in changed],
+                None if None in (r["delta"], r.get("delta_template"))
+                else r["delta"] - r["delta_template"] for r in changed],
             "by_wording": {str(w): {"equivalent": k, "trials": n}
                            for w, (k, n) in sorted(by_wording.items())}}
 
