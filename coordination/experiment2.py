@@ -21,8 +21,9 @@ closest to the site, by Manhattan distance from its start as in the authors' cod
 adds the help job; nothing else changes) and ``b3`` (that forklift takes the help
 job and the exact Oracle re-optimizes everything else).
 
-Each finished trial is appended to ``trials.jsonl`` at once, so an interrupted run
-resumes where it stopped; ``trials.csv``, ``summary.json`` and ``boxplot.png`` are
+Each finished trial's rows are appended to ``trials.jsonl`` at once and made durable
+together (:class:`~ara.eval.run_store.RunStore`), so an interrupted run resumes where
+it stopped; ``trials.csv``, ``summary.json`` and ``boxplot.png`` are
 written from it at the end (:mod:`ara.coordination.exp2_report`). The settings are
 :class:`~ara.coordination.exp2_config.Exp2Config`, the instances
 :mod:`ara.coordination.trials`.
@@ -62,7 +63,9 @@ from ara.coordination.protocol import (
     template_help_spec,
 )
 from ara.coordination.trials import PAPER_WORLD, Trial, closest_robot, make_trial
-from ara.errors import ConfigError
+
+#: The run folder's row log: one JSON line per (trial, method).
+TRIALS = "trials.jsonl"
 
 
 def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
@@ -158,47 +161,32 @@ def _against_template(world, trial: Trial, request: HelpRequest, helpers, offers
 def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory=None,
         progress: bool = True) -> dict:
     """Run (or resume) the experiment into ``out``; returns the summary."""
+    from tqdm import tqdm
+
+    from ara.eval.run_store import RunStore, read_samples
+    from ara.provenance import git_commit
+
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    record = out / "run.json"
-    settings = asdict(config)
     # The translator first: its model hash belongs to the run's identity, so a resumed
     # run cannot mix answers of two adapters.
     translator = SharedTranslator(translator_factory()) if translator_factory else None
-    model = translator.backend.model_id if translator else None
-    if record.exists():
-        old = json.loads(record.read_text())
-        if (old["config"], old.get("translator")) != (settings, model):
-            raise ConfigError(f"{out} holds a run with other settings ({old['config']}, "
-                              f"translator {old.get('translator')}); choose another --out "
-                              "or delete it")
-    else:
-        from ara.provenance import git_commit
-
-        record.write_text(json.dumps({"config": settings, "translator": model,
-                                      "git_commit": git_commit()}, indent=2) + "\n")
-    store = out / "trials.jsonl"
-    done = _load_rows(store)
-    # Keep only whole trials: a line cut by an interruption, or a trial with some of its
-    # methods missing, would otherwise sit in front of what is appended next.
-    tmp = store.with_suffix(".tmp")
-    tmp.write_text("".join(json.dumps(r) + "\n" for r in done))
-    tmp.replace(store)
-    finished = {r["trial"] for r in done}
-    todo = [make_trial(i, config.seed + i, config.robots, config.jobs, config.instances)
-            for i in range(config.trials) if i not in finished]
-    from tqdm import tqdm
-
-    bar = tqdm(total=config.trials, initial=config.trials - len(todo), desc="exp2",
-               unit="trial", disable=not progress)
-    with store.open("a") as sink:
+    meta = {"config": asdict(config),
+            "translator": translator.backend.model_id if translator else None,
+            "git_commit": git_commit()}
+    # Whole trials only: a trial with some of its methods missing (an interruption)
+    # runs again rather than sit in front of what is appended next.
+    with RunStore(out, meta, resume=True, samples=TRIALS, key=_row_key,
+                  identity=("config", "translator"), keep=_whole_trials) as store:
+        finished = {trial for trial, _ in store.done}
+        todo = [make_trial(i, config.seed + i, config.robots, config.jobs, config.instances)
+                for i in range(config.trials) if i not in finished]
+        bar = tqdm(total=config.trials, initial=config.trials - len(todo), desc="exp2",
+                   unit="trial", disable=not progress)
         for rows in _map(todo, config, n_jobs, translator):
-            for r in rows:
-                sink.write(json.dumps(r) + "\n")
-            sink.flush()
+            store.append(*rows)
             bar.update()
-    bar.close()
-    rows = _load_rows(store)
+        bar.close()
+    rows = read_samples(out, TRIALS)
     write_csv(rows, out / "trials.csv")
     summary = summarize(rows, config)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
@@ -236,18 +224,12 @@ def _map(trials: Sequence[Trial], config: Exp2Config, n_jobs: int, translator):
         delayed(run_trial)(t, config) for t in trials)
 
 
-def _load_rows(path: Path) -> list[dict]:
-    if not path.exists():
-        return []
-    rows = []
-    for line in path.read_text().splitlines():
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError:  # a line cut by an interruption: that trial reruns
-            break
-    complete = {}
+def _row_key(row: dict) -> tuple:
+    return row["trial"], row["method"]
+
+
+def _whole_trials(rows: list[dict]) -> list[dict]:
+    by_trial: dict[int, list[dict]] = {}
     for r in rows:
-        complete.setdefault(r["trial"], []).append(r)
-    return [r for t, rs in complete.items() if len(rs) == len(METHODS) for r in rs]
-
-
+        by_trial.setdefault(r["trial"], []).append(r)
+    return [r for rs in by_trial.values() if len(rs) == len(METHODS) for r in rs]

@@ -16,10 +16,10 @@ import time
 from dataclasses import dataclass, field
 from typing import Protocol
 
+from ara.coordination.status import WITH_SOLUTION, Status, checked
 from ara.errors import AraError, ConfigError
 
 INF = float("inf")
-STATUSES = ("optimal", "feasible", "infeasible", "time_limit", "error")
 
 
 @dataclass
@@ -91,16 +91,19 @@ class Solution:
         message: The solver's own words when it failed.
     """
 
-    status: str
+    status: Status
     objective: float | None = None
     values: dict[str, float] = field(default_factory=dict)
     gap: float | None = None
     solve_s: float = 0.0
     message: str = ""
 
+    def __post_init__(self) -> None:
+        checked(self.status)
+
     @property
     def has_solution(self) -> bool:
-        return self.status in ("optimal", "feasible")
+        return self.status in WITH_SOLUTION
 
 
 class MILPSolver(Protocol):

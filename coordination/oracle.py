@@ -22,8 +22,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
+from ara.coordination import routing
 from ara.coordination.milp import LinearModel, MILPSolver, make_solver
 from ara.coordination.planner_dp import Job, leg_lengths
+from ara.coordination.status import Status, checked
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import AraError, ConfigError
 
@@ -73,8 +75,8 @@ class Fleet:
             if legs is None:
                 raise FleetError(f"no path from robot {k}'s start {start} to every job cell, "
                                  "or from one job to another")
-            first.append(legs[0])
-        return first, legs[1]
+            first.append(legs.from_start)
+        return first, legs.between
 
 
 @dataclass(frozen=True)
@@ -85,10 +87,13 @@ class Schedule:
     makespans: tuple[int, ...]
     help_time: int
     cost: int  # sum of makespans + help_time
-    feasible: bool  # every makespan within the cap
-    status: str = "heuristic"
+    feasible: bool  # a schedule, every makespan within the cap
+    status: Status = "heuristic"
     solve_s: float = 0.0
     extra: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        checked(self.status)
 
 
 def _walk(fleet: Fleet, k: int, route: Sequence[int]) -> tuple[int, int]:
@@ -286,70 +291,49 @@ def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int]
     horizon = fleet.cap if fleet.cap is not None else sum(
         max(max(first[k][j] for k in range(robots)), max(then[i][j] for i in range(n)))
         for j in range(n))
-    big = horizon + max(max(map(max, first)), max(map(max, then))) + 1
-    m = LinearModel()
-    for j in range(n):
-        m.var(f"c[{j}]", min(first[k][j] for k in range(robots)), horizon)
-        m.var(f"u[{j}]", 1, n)
-        if pinned:
-            m.var(f"r[{j}]", 0, robots - 1)
-    for k in range(robots):
-        for j in range(n):
-            if j in pinned and pinned[j] != k:
-                continue
-            m.binary(f"x[{k},{j}]", cost=first[k][j])
-    for i in range(n):
-        for j in range(n):
-            if i != j:
-                m.binary(f"y[{i},{j}]", cost=then[i][j])
+    problem = _routing_problem(fleet, pinned, horizon)
+    m = routing.build(problem)
+    for leg in problem.legs:  # the sum of chosen legs is the sum of makespans
+        m.add_cost(leg.arc, leg.steps)
     if fleet.help_job is not None:
         m.add_cost(f"c[{fleet.help_job}]", 1)
-    has = m.index.__contains__
-    for j in range(n):
-        m.eq({**{f"x[{k},{j}]": 1 for k in range(robots) if has(f"x[{k},{j}]")},
-              **{f"y[{i},{j}]": 1 for i in range(n) if i != j}}, 1)
-        m.le({f"y[{j},{x}]": 1 for x in range(n) if x != j}, 1)
-    for k in range(robots):
-        row = {f"x[{k},{j}]": 1 for j in range(n) if has(f"x[{k},{j}]")}
-        if row:
-            m.le(row, 1)
-    for k in range(robots):
+    if pinned:  # r[j]: the robot doing job j, equal along a route
         for j in range(n):
-            if has(x := f"x[{k},{j}]"):
-                m.ge({f"c[{j}]": 1, x: -big}, first[k][j] - big)
-                if pinned:
-                    m.le({f"r[{j}]": 1, x: robots}, k + robots)
-                    m.ge({f"r[{j}]": 1, x: -robots}, k - robots)
-    for i in range(n):
-        for j in range(n):
-            if i == j:
-                continue
-            y = f"y[{i},{j}]"
-            m.ge({f"c[{j}]": 1, f"c[{i}]": -1, y: -big}, then[i][j] - big)
-            m.ge({f"u[{j}]": 1, f"u[{i}]": -1, y: -n}, 1 - n)
-            if pinned:
-                m.le({f"r[{j}]": 1, f"r[{i}]": -1, y: robots}, robots)
-                m.ge({f"r[{j}]": 1, f"r[{i}]": -1, y: -robots}, -robots)
-    for j, k in pinned.items():
-        m.row({f"r[{j}]": 1}, k, k)
+            m.var(f"r[{j}]", 0, robots - 1)
+        for leg in problem.legs:
+            r, x = f"r[{leg.stop}]", leg.arc
+            if leg.from_depot:
+                k = int(leg.origin)
+                m.le({r: 1, x: robots}, k + robots)
+                m.ge({r: 1, x: -robots}, k - robots)
+            else:
+                m.le({r: 1, f"r[{leg.origin}]": -1, x: robots}, robots)
+                m.ge({r: 1, f"r[{leg.origin}]": -1, x: -robots}, -robots)
+        for j, k in pinned.items():
+            m.row({f"r[{j}]": 1}, k, k)
     solver = solver or make_solver()
-    solution = solver.solve(m, time_limit_s)
+    solution = routing.solve(m, solver, time_limit_s)
     if not solution.has_solution:
         return Schedule((), (), 0, 0, False, solution.status, solution.solve_s)
+    size = m.size  # the model's own, without the canonical solve's bound row
     if canonical and solution.status == "optimal":
         solution = _canonical(m, solution, solver, time_limit_s)
-    v = solution.values
-    routes = []
-    for k in range(robots):
-        route, prev = [], next((j for j in range(n) if v.get(f"x[{k},{j}]", 0) > 0.5), None)
-        while prev is not None:
-            route.append(prev)
-            prev = next((j for j in range(n) if j != prev and v[f"y[{prev},{j}]"] > 0.5), None)
-        routes.append(route)
-    schedule = evaluate(fleet, routes, solution.status, solution.solve_s)
-    return Schedule(schedule.routes, schedule.makespans, schedule.help_time, schedule.cost,
-                    schedule.feasible, solution.status, solution.solve_s,
-                    {"gap": solution.gap, **m.size})
+    routes = [[int(j) for j in route] for route in routing.routes(problem, solution.values)]
+    return replace(evaluate(fleet, routes, solution.status, solution.solve_s),
+                   extra={"gap": solution.gap, **size})
+
+
+def _routing_problem(fleet: Fleet, pinned: dict[int, int], horizon: int):
+    """Robots as depots, jobs as stops: ``x[k,j]`` robot k does j first, ``y[i,j]`` j
+    right after i, ``c[j]`` the step job j is done."""
+    first, then = fleet.legs
+    n, robots = len(fleet.jobs), len(fleet.starts)
+    legs = [routing.Leg(str(k), str(j), first[k][j], f"x[{k},{j}]", from_depot=True)
+            for k in range(robots) for j in range(n) if pinned.get(j, k) == k]
+    legs += [routing.Leg(str(i), str(j), then[i][j], f"y[{i},{j}]")
+             for i in range(n) for j in range(n) if i != j]
+    return routing.RoutingProblem(tuple(map(str, range(robots))), tuple(map(str, range(n))),
+                                  tuple(legs), horizon, time="c")
 
 
 def _canonical(m: LinearModel, first, solver: MILPSolver, time_limit_s: float):

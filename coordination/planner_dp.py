@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ara.coordination.status import WITH_SOLUTION, Status, checked
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import ConfigError
 
@@ -59,15 +60,18 @@ class Plan:
         objective: Value of the objective minimized.
     """
 
-    status: str
+    status: Status
     order: tuple[int, ...] = ()
     completion: tuple[int, ...] = ()
     makespan: int = 0
     objective: int = 0
 
+    def __post_init__(self) -> None:
+        checked(self.status)
+
     @property
     def feasible(self) -> bool:
-        return self.status == "optimal"
+        return self.status in WITH_SOLUTION
 
 
 def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "makespan",
@@ -92,7 +96,8 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
     legs = leg_lengths(world, start, jobs)
     if legs is None:
         return Plan("unreachable")
-    from_start, between, start_travel, travel = legs
+    from_start, between = legs.from_start, legs.between
+    start_travel, travel = legs.start_travel, legs.travel
     help_bit = 0 if help_index is None else 1 << help_index
 
     def weight(mask: int, d: int, moved: int) -> int:
@@ -178,9 +183,26 @@ def _plan_within_cap(n, from_start, between, start_travel, travel, weight, cap):
     return order[::-1], cost
 
 
-def leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
-    """Steps from the start to finish each job, and from finishing one job to the next;
-    then the same without the dwell (the travelled part, D in the objectives)."""
+@dataclass(frozen=True)
+class JobLegs:
+    """A robot's legs over a job list: steps to *finish* a job (travel to its pick,
+    carry to its drop, its dwell), first from the start, then from finishing another.
+
+    Attributes:
+        from_start: ``from_start[j]``: steps from the start until job j is done.
+        between: ``between[i][j]``: steps from finishing job i until job j is done.
+        start_travel, travel: The same without the dwell (the part travelled, D in
+            the objectives).
+    """
+
+    from_start: list[int]
+    between: list[list[int]]
+    start_travel: list[int]
+    travel: list[list[int]]
+
+
+def leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]) -> JobLegs | None:
+    """The legs of ``jobs`` for a robot at ``start``; None if a cell cannot be reached."""
     def dist(a: Cell, b: Cell) -> int | None:
         return world.distance(a, b) if world.is_free(a) and world.is_free(b) else None
 
@@ -192,9 +214,9 @@ def leg_lengths(world: GridWorld, start: Cell, jobs: list[Job]):
     n = range(len(jobs))
     start_travel = [first[j] + own[j] for j in n]
     travel = [[to_pick[i][j] + own[j] for j in n] for i in n]
-    from_start = [start_travel[j] + jobs[j].dwell for j in n]
-    between = [[travel[i][j] + jobs[j].dwell for j in n] for i in n]
-    return from_start, between, start_travel, travel
+    return JobLegs(from_start=[start_travel[j] + jobs[j].dwell for j in n],
+                   between=[[travel[i][j] + jobs[j].dwell for j in n] for i in n],
+                   start_travel=start_travel, travel=travel)
 
 
 def _unwind(parent: list[list[int]], mask: int, last: int) -> list[int]:

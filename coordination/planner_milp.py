@@ -1,14 +1,14 @@
 """The event-based MILP: an event program + a grid -> a robot's optimal plan.
 
 Nodes are the start and the required events; travel times are BFS distances between
-their cells (without the cells the spec keeps out of) plus each event's dwell.
+their cells (without the cells the spec keeps out of) plus each event's dwell. The
+ordering part is :mod:`ara.coordination.routing`'s, with the start as the one depot:
 
-- ``x[i,j]`` (binary): event j comes right after node i; every event has one
-  predecessor, every node at most one successor, so the plan is one path from start.
-- ``u[j]``: position in the path (MTZ order, which also forbids cycles of zero-length
-  legs, e.g. a pick and a place at the same cell);
-- ``t[j]``: the step event j happens; ``t[j] >= t[i] + w[i,j]`` along chosen legs,
-  waiting allowed;
+- ``x[i,j]`` (binary): event j comes right after node i, one path from the start;
+- ``u[j]``: position in the path; ``t[j]``: the step event j happens;
+
+and the spec adds:
+
 - windows bound ``t[event] - t[anchor]`` and order the event after the anchor;
   "no y between a and b" is a disjunction (y before a, or after b) with one binary.
 
@@ -22,9 +22,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from ara.coordination import routing
 from ara.coordination.events import START, EventProgram, Vocabulary, compile_spec
-from ara.coordination.milp import LinearModel, MILPSolver, make_solver
+from ara.coordination.milp import MILPSolver
 from ara.coordination.planner_dp import OBJECTIVES
+from ara.coordination.status import WITH_SOLUTION, Status, checked
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import ConfigError
 from ara.grammars import Formula
@@ -46,7 +48,7 @@ class EventPlan:
         solve_s: Solver wall time; ``gap``: its relative MIP gap; ``size``: model size.
     """
 
-    status: str
+    status: Status
     order: tuple[str, ...] = ()
     times: dict[str, int] = field(default_factory=dict)
     makespan: int = 0
@@ -56,9 +58,12 @@ class EventPlan:
     gap: float | None = None
     size: dict[str, int] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        checked(self.status)
+
     @property
     def feasible(self) -> bool:
-        return self.status in ("optimal", "feasible")
+        return self.status in WITH_SOLUTION
 
 
 def plan_spec(world: GridWorld, start: Cell, conjuncts: dict[str, Formula],
@@ -96,12 +101,12 @@ def solve_program(world: GridWorld, start: Cell, program: EventProgram, vocab: V
     weights = _leg_weights(world, cells, program.avoid, vocab)
     if weights is None:
         return EventPlan("unreachable")
-    model, scale = _build(program, weights, objective, cap)
-    solution = (solver or make_solver()).solve(model, time_limit_s)
+    problem, model, scale = _build(program, weights, objective, cap)
+    solution = routing.solve(model, solver, time_limit_s)
     if not solution.has_solution:
         return EventPlan(solution.status, solve_s=solution.solve_s, size=model.size)
     v = solution.values
-    order = tuple(sorted(events, key=lambda e: round(v[f"u[{e}]"])))
+    (order,) = routing.routes(problem, v)
     times = _earliest_times(order, weights, program) or {e: round(v[f"t[{e}]"]) for e in events}
     help_events = program.groups.get("help", set())
     help_time = max((times[e] for e in help_events), default=0) if "help" in program.groups \
@@ -164,28 +169,13 @@ def _build(program: EventProgram, weights: dict, objective: str, cap: int | None
         horizon += max(finite_his)
     if cap is not None:
         horizon = min(horizon, cap)
-    big = horizon + longest + 1
-    m = LinearModel()
-    for e in events:  # no event before the robot can reach it: a bound the LP can use
-        m.var(f"t[{e}]", weights[START, e][1], horizon)
-        m.var(f"u[{e}]", 1, n)
+    problem = routing.RoutingProblem(
+        (START,), tuple(events),
+        tuple(routing.Leg(i, j, w, f"x[{i},{j}]", from_depot=i == START)
+              for (i, j), (_, w) in weights.items()),
+        horizon, depots_leave=True)
+    m = routing.build(problem)
     m.var("M", 0, horizon)
-    for i, j in weights:
-        m.binary(f"x[{i},{j}]")
-    # one path from the start through every event
-    for j in events:
-        m.eq({f"x[{i},{j}]": 1 for i in [START, *events] if (i, j) in weights}, 1)
-    for i in [START, *events]:
-        succ = {f"x[{i},{j}]": 1 for j in events if (i, j) in weights}
-        if succ:
-            (m.eq if i == START else m.le)(succ, 1)
-    for (i, j), (_, w) in weights.items():
-        x = f"x[{i},{j}]"
-        if i == START:
-            m.ge({f"t[{j}]": 1, x: -w}, 0)
-            continue
-        m.ge({f"t[{j}]": 1, f"t[{i}]": -1, x: -big}, w - big)
-        m.ge({f"u[{j}]": 1, f"u[{i}]": -1, x: -n}, 1 - n)
     for e in events:
         m.ge({"M": 1, f"t[{e}]": -1}, 0)
     for w in program.windows:  # the start is step 0, before everything
@@ -220,7 +210,7 @@ def _build(program: EventProgram, weights: dict, objective: str, cap: int | None
             m.var("T_help", 0, horizon, cost=scale)
             for e in program.groups["help"]:
                 m.ge({"T_help": 1, f"t[{e}]": -1}, 0)
-    return m, scale
+    return problem, m, scale
 
 
 def _adjacent_pairs(program: EventProgram) -> list[tuple[str, str]]:

@@ -23,6 +23,7 @@ from ara.coordination.milp import MILPSolver
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
 from ara.coordination.specs import (
+    carry_alone,
     job_names,
     jobs_spec,
     jobs_vocabulary,
@@ -251,13 +252,14 @@ class HelpRound:
 
 def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: str = "dp",
                objective: str = "paper", cap: int | None = 50, translator=None,
-               shots: Sequence | None = None, solver: MILPSolver | None = None) -> Offer:
+               shots: Sequence | None = None, solver: MILPSolver | None = None,
+               help_formula: Formula | None = None) -> Offer:
     """A helper reads the request, writes its STL, plans, and bids.
 
     With a ``translator`` the help formula is the translator's (logged in the offer,
-    right or wrong, and planned as it says); without one it is the template spec.
-    The DP planner handles the template spec only. ``shots`` default to
-    :func:`request_shots`.
+    right or wrong, and planned as it says); with ``help_formula`` it is that formula
+    (over :func:`help_props`); otherwise it is the template spec. The DP planner
+    handles the template spec only. ``shots`` default to :func:`request_shots`.
     """
     if planner not in PLANNERS:
         raise ProtocolError(f"planner must be one of {PLANNERS}, got {planner!r}")
@@ -268,7 +270,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     before = plan_jobs(world, helper.start, list(helper.jobs), "makespan")
     if not before.feasible:
         return _decline(helper, "my own jobs cannot be planned")
-    if planner == "dp" and translator is None:
+    if planner == "dp" and translator is None and help_formula is None:
         jobs = [*helper.jobs, Job(site, drop, name="help")]
         after = plan_jobs(world, helper.start, jobs, objective,
                           help_index=len(jobs) - 1, cap=cap)
@@ -283,18 +285,22 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     pick, place = help_props(site, drop)
     own_vocab = jobs_vocabulary(world, list(helper.jobs))
     vocab = own_vocab.merged(Vocabulary({pick: site, place: drop}))
-    if translator is None:
-        help_formula = template_help_spec(site, drop, sorted(own_vocab.events))
-    else:
+    template = template_help_spec(site, drop, sorted(own_vocab.events))
+    if translator is not None:
         shots = request_shots() if shots is None else shots
         result = translator.translate(request.text, (pick, place), shots, constrained=True)
         if not result.valid:
             return _decline(helper, f"could not translate the request ({result.error})")
         help_formula = parse(result.stl)
+    help_formula = template if help_formula is None else help_formula
+    own = jobs_spec(list(helper.jobs), (pick, place))
+    if help_formula != template:
+        # A forklift carries one pallet at a time. The template says so for the help
+        # pallet; a translated request says only what the requester wants (it cannot
+        # name the helper's own jobs), so the helper adds its capacity itself.
+        own = And((own, carry_alone(pick, place, sorted(own_vocab.events))))
     try:
-        after = plan_spec(world, helper.start,
-                          {"own": jobs_spec(list(helper.jobs), (pick, place)),
-                           "help": help_formula},
+        after = plan_spec(world, helper.start, {"own": own, "help": help_formula},
                           vocab, objective, cap, solver)
     except (UnsupportedSpec, WorldError) as err:
         return _decline(helper, str(err), stl_text(help_formula))

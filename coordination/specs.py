@@ -35,11 +35,18 @@ def place_ap(name: str) -> str:
 def pnp_spec(name: str, others: Sequence[str] = ()) -> Formula:
     """phi1 & phi2 & phi3 for job ``name``; ``others`` are the other jobs' propositions."""
     pick, place = Atom(pick_ap(name)), Atom(place_ap(name))
-    carry: Formula = Eventually(place)  # true U place
+    return And((Until(Not(place), pick), carry_alone(pick.name, place.name, others),
+                Eventually(place)))
+
+
+def carry_alone(pick: str, place: str, others: Sequence[str]) -> Formula:
+    """phi2: once ``pick`` happens, none of ``others`` before ``place`` (one pallet at a
+    time); ``G(pick -> F place)`` when there are no others."""
+    carry: Formula = Eventually(Atom(place))  # true U place
     if others:
         blocked = Atom(others[0]) if len(others) == 1 else Or(tuple(Atom(o) for o in others))
-        carry = Until(Not(blocked), place)
-    return And((Until(Not(place), pick), Always(Implies(pick, carry)), Eventually(place)))
+        carry = Until(Not(blocked), Atom(place))
+    return Always(Implies(Atom(pick), carry))
 
 
 def global_spec() -> Formula:

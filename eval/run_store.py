@@ -1,14 +1,17 @@
 """A run directory: ``run.json`` (what produced it) and ``samples.jsonl`` (append-only).
 
 Each sample is written as one line and fsynced before the next generation starts. A
-run killed mid-write leaves at most one partial last line, which :meth:`open` cuts
-off before resuming, so no sample is lost or duplicated.
+run killed mid-write leaves at most one partial last line, which opening the store
+cuts off before resuming, so no sample is lost or duplicated. Evaluation runs store
+one sample per (variant, shots, rerun, uid); Experiment 2 stores its trials' rows the
+same way (``trials.jsonl``, keyed by trial and method, whole trials only).
 """
 
 from __future__ import annotations
 
 import json
 import os
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ara.errors import AraError
@@ -16,6 +19,8 @@ from ara.errors import AraError
 RUN = "run.json"
 SAMPLES = "samples.jsonl"
 KEY_FIELDS = ("variant", "shots", "rerun", "uid")
+#: The fields of run.json that make two runs the same run.
+IDENTITY = ("config", "model_id", "data", "grammar_version")
 
 
 class RunDirError(AraError, ValueError):
@@ -26,11 +31,11 @@ def sample_key(sample: dict) -> tuple:
     return tuple(sample[k] for k in KEY_FIELDS)
 
 
-def read_samples(folder: Path) -> list[dict]:
+def read_samples(folder: Path, samples: str = SAMPLES) -> list[dict]:
     """The complete sample lines of a run (a partial last line is ignored)."""
-    path = folder / SAMPLES
+    path = folder / samples
     if not path.is_file():
-        raise RunDirError(f"no {SAMPLES} in {folder}: not an evaluation run folder")
+        raise RunDirError(f"no {samples} in {folder}: not an evaluation run folder")
     samples = []
     for line in path.read_text().splitlines():
         try:
@@ -47,29 +52,40 @@ class RunStore:
         folder: The run's output folder.
         meta: What produced the run (:func:`ara.eval.harness.run_metadata`).
         resume: Continue the run in ``folder``; otherwise the folder must hold none.
+        samples: The log's file name.
+        key: A sample's identity; a resumed run skips the keys in :attr:`done`.
+        identity: The fields of ``meta`` a resumed run must share with the saved one.
+        keep: Which saved samples a resumed run keeps (all by default); the log is
+            rewritten without the others, e.g. the rows of an unfinished trial.
 
     Raises:
         RunDirError: If ``folder`` holds a run and ``resume`` is off, or it holds a
             different run than ``meta`` describes.
     """
 
-    def __init__(self, folder: Path, meta: dict, resume: bool) -> None:
-        self.folder = folder
+    def __init__(self, folder: Path, meta: dict, resume: bool, *, samples: str = SAMPLES,
+                 key: Callable[[dict], tuple] = sample_key, identity: Sequence[str] = IDENTITY,
+                 keep: Callable[[list[dict]], list[dict]] | None = None) -> None:
+        self.folder, self.key = folder, key
         folder.mkdir(parents=True, exist_ok=True)
-        run_path, samples_path = folder / RUN, folder / SAMPLES
+        run_path, samples_path = folder / RUN, folder / samples
         if run_path.exists() and not resume:
             raise RunDirError(
                 f"{folder} already holds a run; pass --resume to continue it, or choose "
                 "another --out"
             )
         if resume and run_path.exists():
-            _check_same_run(json.loads(run_path.read_text()), meta, folder)
+            _check_same_run(json.loads(run_path.read_text()), meta, folder, identity)
         else:
             run_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
         self.done: set[tuple] = set()
         if samples_path.exists():
             self._cut_partial_line(samples_path)
-            self.done = {sample_key(s) for s in read_samples(folder)}
+            saved = read_samples(folder, samples)
+            if keep is not None and len(kept := keep(saved)) != len(saved):
+                _rewrite(samples_path, kept)
+                saved = kept
+            self.done = {key(s) for s in saved}
         self._fh = open(samples_path, "a", encoding="utf-8")
 
     @staticmethod
@@ -80,11 +96,13 @@ class RunStore:
             with open(path, "r+b") as fh:
                 fh.truncate(end)
 
-    def append(self, sample: dict) -> None:
-        self._fh.write(json.dumps(sample, sort_keys=True) + "\n")
+    def append(self, *samples: dict) -> None:
+        """Write ``samples`` (one line each) and make them durable together."""
+        for sample in samples:
+            self._fh.write(json.dumps(sample, sort_keys=True) + "\n")
         self._fh.flush()
         os.fsync(self._fh.fileno())
-        self.done.add(sample_key(sample))
+        self.done.update(self.key(s) for s in samples)
 
     def close(self) -> None:
         self._fh.close()
@@ -96,9 +114,15 @@ class RunStore:
         self.close()
 
 
-def _check_same_run(old: dict, new: dict, folder: Path) -> None:
+def _rewrite(path: Path, samples: list[dict]) -> None:
+    """Replace the log atomically: an interruption leaves the old one or the new one."""
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text("".join(json.dumps(s, sort_keys=True) + "\n" for s in samples))
+    tmp.replace(path)
+
+
+def _check_same_run(old: dict, new: dict, folder: Path, identity: Sequence[str]) -> None:
     """A resumed run must be the same run: config, model and data version."""
-    identity = ("config", "model_id", "data", "grammar_version")
     diffs = [k for k in identity if old.get(k) != new.get(k)]
     if diffs:
         detail = "; ".join(f"{k}: {old.get(k)!r} != {new.get(k)!r}" for k in diffs)

@@ -8,6 +8,7 @@ import pytest
 from ara.coordination.experiment2 import METHODS, Exp2Config, run, run_trial, table
 from ara.coordination.trials import closest_robot, make_trial
 from ara.errors import ConfigError
+from ara.eval.run_store import RunDirError
 
 
 @pytest.mark.parametrize(("seed", "site", "starts", "first_jobs", "last_job"), [
@@ -100,7 +101,7 @@ def test_run_writes_the_file_contract_and_resumes(tmp_path):
     assert b2["trials"] <= 3 and "both are feasible" in b2["formula"]
     assert "counted until arrival" in table(summary)
     assert (out / "boxplot.png").stat().st_size > 1000
-    with pytest.raises(ConfigError, match="other settings"):
+    with pytest.raises(RunDirError, match="different config"):
         run(Exp2Config(trials=4), out, progress=False)
 
 
@@ -151,7 +152,7 @@ def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
     assert seen["equivalent_to_template"] == sum(r["template_equivalent"] is True for r in ours)
     record = json.loads((out / "run.json").read_text())
     assert record["translator"] == llama_backend.model_id
-    with pytest.raises(ConfigError, match="translator gguf:"):
+    with pytest.raises(RunDirError, match="different translator .*'gguf:"):
         run(config, out, progress=False)
 
 

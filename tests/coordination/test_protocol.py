@@ -133,3 +133,29 @@ def test_the_shipped_translator_reads_a_reworded_request_as_the_template_spec(
     result = shipped_translator.translate(request_text(site, CAPS, wording=wording),
                                           help_props(site, drop), request_shots())
     assert equivalent(parse(result.stl), template_help_spec(site, drop, ()), timeout_s=30)
+
+
+def test_a_helper_given_the_bare_help_spec_still_carries_one_pallet_at_a_time():
+    """Tests what a helper adds to a formula it did not write: the request can only say
+    pick-before-place for the help pallet (it cannot name the helper's own jobs), and
+    the helper adds that it carries one pallet at a time. Every forklift of the paper's
+    trial 34 then bids exactly as with the template spec; planning the bare formula as
+    it stands let the winner carry two pallets at once and bid 4 instead of 6."""
+    from ara.coordination.experiment2 import CAPABILITIES
+    from ara.coordination.oracle import Fleet, exact
+    from ara.coordination.trials import make_trial
+
+    trial = make_trial(34, 3034)
+    before = exact(Fleet(WORLD, trial.starts, trial.jobs, cap=50))
+    helpers = [Helper(k, trial.starts[k], tuple(trial.jobs[j] for j in route))
+               for k, route in enumerate(before.routes)]
+    req = HelpRequest("requester", trial.site, CAPABILITIES,
+                      request_text(trial.site, CAPABILITIES))
+    bare = template_help_spec(trial.site, trial.help_job.drop, ())
+    for h in helpers:
+        template = make_offer(WORLD, h, req, planner="milp")
+        given = make_offer(WORLD, h, req, planner="milp", help_formula=bare)
+        assert (given.can_help, given.tau_help, given.tau_new) == \
+            (template.can_help, template.tau_help, template.tau_new), h.index
+    bids = [make_offer(WORLD, h, req, planner="milp") for h in helpers]
+    assert bids[choose(bids)].bid == 6
