@@ -116,6 +116,9 @@ class TrainConfig:
             prepare``), a local HF folder, or a hub id already in the local cache.
         out: Run folder: checkpoints, the adapter, ``train_log.jsonl``, ``run.json``.
         seed: Seeds the data order, dropout and adapter initialization.
+        init_adapter: A PEFT adapter folder (``adapter/`` of an earlier run) to start
+            from instead of a fresh LoRA: a warm start with its own optimizer and
+            schedule, for a second pass or new data. Its LoRA shape must match ``lora``.
         max_steps: Stop after this many optimizer steps (``None``: the epochs decide).
         checkpoint_every: Save a resumable checkpoint every N steps, >= 1.
         eval_pairs: Test pairs for the held-out check at the end (0: none).
@@ -125,6 +128,7 @@ class TrainConfig:
     base_model: str = "default"
     out: str = "runs/train/gemma3-270m-lora"
     seed: int = 0
+    init_adapter: str | None = None
     max_steps: int | None = None
     checkpoint_every: int = 100
     eval_pairs: int = 100
@@ -137,6 +141,8 @@ class TrainConfig:
             raise ConfigError(f"max_steps must be >= 1 or null, got {self.max_steps}")
         if self.checkpoint_every < 1 or self.eval_pairs < 0:
             raise ConfigError("checkpoint_every must be >= 1 and eval_pairs >= 0")
+        if self.init_adapter is not None and not str(self.init_adapter).strip():
+            raise ConfigError("init_adapter must be an adapter folder or null, got ''")
 
     @classmethod
     def from_dict(cls, data: dict) -> TrainConfig:

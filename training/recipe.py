@@ -49,6 +49,10 @@ class LoRAFinetuneRecipe:
             raise ConfigError(f"{self.out} already holds a run: pass --resume or another out")
         if resume and self.out.joinpath("run.json").exists():
             _refuse_changed_config(self.out / "run.json", config)
+        if config.init_adapter and not Path(config.init_adapter, "adapter_config.json").is_file():
+            raise ConfigError(
+                f"init_adapter: {config.init_adapter} holds no adapter_config.json; name the "
+                "adapter/ folder of a finished run (train that run first)")
         self.step = 0
 
     # -- setup: each part needs the ones before it ------------------------------------
@@ -109,6 +113,8 @@ class LoRAFinetuneRecipe:
         base = AutoModelForCausalLM.from_pretrained(self.model_dir, local_files_only=True,
                                                     dtype=dtype)
         lora = self.config.lora
+        if self.config.init_adapter:
+            return _warm_started(base, self.config.init_adapter, lora)
         return get_peft_model(base, LoraConfig(
             r=lora.r, lora_alpha=lora.alpha, lora_dropout=lora.dropout,
             target_modules=lora.target_modules, task_type="CAUSAL_LM"))
@@ -131,6 +137,7 @@ class LoRAFinetuneRecipe:
                          "train_examples": len(self.train_records)},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "processes": self.accelerator.num_processes,
+                "init_adapter": _adapter_identity(self.config.init_adapter),
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
 
@@ -277,6 +284,35 @@ class LoRAFinetuneRecipe:
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
 #: how often it checkpoints, and the held-out check at its end.
 _RESUMABLE_KEYS = {"max_steps", "eval_pairs", "checkpoint_every"}
+
+
+def _warm_started(base, folder: str, lora):
+    """``base`` with the trainable adapter saved in ``folder``, checked against ``lora``:
+    a warm start whose shape differs from the config would record one thing and train
+    another."""
+    from peft import PeftModel
+
+    model = PeftModel.from_pretrained(base, folder, is_trainable=True)
+    saved = model.peft_config["default"]
+    mismatched = {name: (got, want) for name, got, want in (
+        ("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha))
+        if got != want}
+    if mismatched:
+        detail = ", ".join(f"{k}: adapter {g} vs config {w}" for k, (g, w) in mismatched.items())
+        raise ConfigError(f"init_adapter {folder} has another LoRA shape ({detail}); "
+                          "set lora to the adapter's values")
+    return model
+
+
+def _adapter_identity(folder: str | None) -> dict | None:
+    """Where a warm start came from: the folder and its weights' hash."""
+    if not folder:
+        return None
+    from ara.provenance import sha256_file
+
+    weights = sorted(Path(folder).glob("adapter_model.*"))
+    digest = sha256_file(weights[0]) if weights else None
+    return {"path": str(folder), "sha256": digest}
 
 
 def _flat(d: dict, prefix: str = "") -> dict:

@@ -72,6 +72,43 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
     assert report["validity"] == 1.0
 
 
+def test_a_warm_start_continues_from_a_finished_adapter(tiny_gemma_dir, tmp_path):
+    """Tests ``init_adapter``: a second run starting from the first run's adapter begins
+    at the loss the first run ended with (the same batch), not at a fresh LoRA's."""
+    import torch
+
+    first = tiny_config(tiny_gemma_dir, tmp_path / "first",
+                        optim={"lr": 5e-3, "batch_size": 8, "warmup_steps": 0, "epochs": 10})
+    trained = LoRAFinetuneRecipe(first)
+    trained.setup()
+    trained.train()
+    adapter = trained.save_adapter()
+
+    def first_loss(**overrides):
+        config = TrainConfig.from_dict({**first.to_dict(), "max_steps": 1, **overrides})
+        recipe = LoRAFinetuneRecipe(config)
+        recipe.setup()
+        torch.manual_seed(0)
+        return recipe.train()[0], recipe
+
+    # One batch of 8 is the whole data (limit 8): every run's first step sees the same rows.
+    warm, recipe = first_loss(out=str(tmp_path / "warm"), init_adapter=str(adapter))
+    cold, _ = first_loss(out=str(tmp_path / "cold"))
+    ended, _ = first_loss(out=str(tmp_path / "again"), init_adapter=str(adapter))
+    assert warm == pytest.approx(ended) and warm < cold
+    run = json.loads((tmp_path / "warm" / "run.json").read_text())
+    assert run["init_adapter"]["path"] == str(adapter) and len(run["init_adapter"]["sha256"]) == 64
+
+    with pytest.raises(ConfigError, match="no adapter_config.json"):
+        LoRAFinetuneRecipe(TrainConfig.from_dict({**first.to_dict(), "out": str(tmp_path / "x"),
+                                                  "init_adapter": str(tmp_path)}))
+    other_shape = TrainConfig.from_dict({**first.to_dict(), "out": str(tmp_path / "y"),
+                                         "init_adapter": str(adapter),
+                                         "lora": {"r": 8, "alpha": 8, "dropout": 0.0}})
+    with pytest.raises(ConfigError, match="another LoRA shape"):
+        LoRAFinetuneRecipe(other_shape).setup()
+
+
 @pytest.mark.slow  # converts and quantizes a 262k-vocabulary model: about a minute
 def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tmp_path):
     """Tests train -> merge -> GGUF (f32) -> q8_0 and the GGUF LoRA, then that llama.cpp
