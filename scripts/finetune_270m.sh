@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
-# The shipped fine-tune, end to end, on a CPU: about 90 min of training on 2 cores on the
-# compositional mixture, then export, ship and the evaluations (about 45 min).
+# The shipped fine-tune, end to end, on a CPU: two training runs of about 85 and 60 min on
+# 2 cores on the compositional mixture (each fits one session), then export, ship and
+# the evaluations (about 45 min).
 #
-#   scripts/finetune_270m.sh [STEP ...]   steps: train export ship eval paper disjoint full
-#                                         (default: train export ship eval)
+#   scripts/finetune_270m.sh [STEP ...]   steps: train continue export ship eval paper
+#                                         disjoint full
+#                                         (default: train continue export ship eval)
 #
-# train/export/ship: `--model finetuned` (training/configs/gemma3_270m_lora_cpu_compositional.yaml).
+# train: v3 (training/configs/gemma3_270m_lora_cpu_compositional.yaml); continue: v4,
+#   400 more steps from v3's adapter (..._compositional_v4.yaml); export/ship: v4 becomes
+#   `--model finetuned`.
 # eval: the generalization runs of the new adapter, the paper-split adapter and the base
 #   model (scripts/eval_generalization.sh), the round trip, the help-request wordings.
 # paper: retrains the paper-split adapter (`--model finetuned-paper`, Table I) from its
@@ -17,10 +21,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=.venv/bin
-run=runs/train/gemma3-270m-lora-compositional
+first_run=runs/train/gemma3-270m-lora-compositional
+run=runs/train/gemma3-270m-lora-compositional-v4
 paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
-steps=${*:-train export ship eval}
+steps=${*:-train continue export ship eval}
 
 train() {  # CONFIG RUN_FOLDER
   if [ -f "$2/run.json" ]; then resume=--resume; else resume=; fi
@@ -63,7 +68,9 @@ PY
 for step in $steps; do
   case $step in
   train)
-    train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$run" ;;
+    train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
+  continue)
+    train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$run" ;;
   export)
     # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
     $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
@@ -93,6 +100,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train export ship eval paper disjoint full)" >&2; exit 2 ;;
+  *) echo "unknown step $step (train continue export ship eval paper disjoint full)" >&2
+     exit 2 ;;
   esac
 done

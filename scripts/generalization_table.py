@@ -28,7 +28,8 @@ MODELS = {
     "paper-adapter-270m": ("paper adapter (old)", "paper"),
     "compositional-adapter-v1-270m": ("compositional adapter v1", "compositional"),
     "compositional-adapter-v2-270m": ("compositional adapter v2", "compositional"),
-    "compositional-adapter-270m": ("compositional adapter v3 (shipped)", "compositional"),
+    "compositional-adapter-v3-270m": ("compositional adapter v3", "compositional"),
+    "compositional-adapter-270m": ("compositional adapter v4 (shipped)", "compositional"),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),
