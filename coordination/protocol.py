@@ -285,7 +285,8 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     pick, place = help_props(site, drop)
     own_vocab = jobs_vocabulary(world, list(helper.jobs))
     vocab = own_vocab.merged(Vocabulary({pick: site, place: drop}))
-    template = template_help_spec(site, drop, sorted(own_vocab.events))
+    others = sorted(own_vocab.events)
+    template = template_help_spec(site, drop, others)
     if translator is not None:
         shots = request_shots() if shots is None else shots
         result = translator.translate(request.text, (pick, place), shots, constrained=True)
@@ -298,7 +299,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
         # A forklift carries one pallet at a time. The template says so for the help
         # pallet; a translated request says only what the requester wants (it cannot
         # name the helper's own jobs), so the helper adds its capacity itself.
-        own = And((own, carry_alone(pick, place, sorted(own_vocab.events))))
+        own = And((own, carry_alone(pick, place, others)))
     try:
         after = plan_spec(world, helper.start, {"own": own, "help": help_formula},
                           vocab, objective, cap, solver)

@@ -173,13 +173,13 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
             "1000) or rescale the time unit")
 
 
-@lru_cache(maxsize=1024)
 def admits(built: BuiltGrammar, raw: str) -> bool:
     """Whether ``raw`` (stop string removed) is what decoding under ``built`` may
     produce: the answer prefix and a formula of the language."""
     return raw.startswith(ANSWER_PREFIX) and built.syntax.accepts(raw[len(ANSWER_PREFIX):])
 
 
+@lru_cache(maxsize=1024)
 def decoding_grammar(built: BuiltGrammar) -> BuiltGrammar:
     """The grammar decoding runs under: the answer prefix, a formula of ``built``, and the
     newline that ends an answer (see :meth:`Grammar.with_suffix`)."""
