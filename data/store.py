@@ -199,6 +199,12 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
         folder = found[0]
     else:
         folder = root / f"{key}-{version}"
+    registered = registered_versions().get(key)
+    if not folder.is_dir() and registered is not None and version != registered:
+        raise DataVersionError(
+            f"split {key} version {version} is not prepared in {root}, and this release "
+            f"produces {registered}: prepare {version} with the release that registered it "
+            f"(`git log -p data/versions.json`), or train on {registered}")
     if not folder.is_dir():
         raise DataVersionError(
             f"split {key} version {version} is not prepared in {root}; run "

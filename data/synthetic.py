@@ -1,18 +1,25 @@
 """Seeded synthetic NL/STL pairs: formulas drawn from the project's own language,
 worded by the English realizer (:mod:`ara.grammars.english`).
 
-Most formulas are what users write: 40% one pattern (reach, avoid, sequence,
-response, recurrence, persistence, bounded reach and avoid, until), 30% two patterns
-joined by a connective, 15% three patterns that must all hold; the other 15% grow at
-random over every operator of the grammar (``!``, ``&``, ``|``, ``->``, ``<->``, ``F``,
-``G``, ``U``, each temporal one timed or not) up to depth 4. A pattern's operand is now
+Most formulas are what users write: 40% one pattern (reach, avoid, two- and
+three-step sequence, visits in any order, response, recurrence, persistence, bounded
+reach and avoid, until), 30% two patterns joined by a connective, 15% three patterns
+that must all hold, each as deep as the decoding grammar allows (5); the other 15% grow
+at random over every operator of the grammar (``!``, ``&``, ``|``, ``->``, ``<->``,
+``F``, ``G``, ``U``, each temporal one timed or not) up to depth 4. A pattern's operand is now
 and then a small Boolean formula ("both a and b", "a or b", "not a"), so that scope is
 learned. A formula has 1 to 5 propositions, and one may occur twice. Each row is worded
 twice: lifted (``prop_1``...) and grounded (``go_to_kitchen``...).
 
-In grounded form a proposition read at the first instant only (``a`` in ``a -> F(b)``)
-is a condition ("the door is open"), never an action: a command said on its own ("go
-to the kitchen") means *at some point*, and is written ``F(go_to_kitchen)``.
+In grounded form a proposition read at the first instant only (``a`` in ``a -> F(b)``),
+or at the instant of an implication (``a`` and ``b`` in ``G(a -> b)``), is a condition
+("the door is open"), never an action: a command said on its own ("go to the
+kitchen") means *at some point*, and is written ``F(go_to_kitchen)``.
+
+Version 3 (after reading the shipped fine-tune's misses, docs/generalization.md) draws
+three-step sequences, which version 2's depth limit of 4 had silently rejected, says
+conditions where version 2 said commands after "whenever", and adds the visit pattern
+and "in that order" / "in any order".
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -52,7 +59,11 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "2.0.0"
+SYNTHETIC_VERSION = "3.0.0"
+#: Deepest pattern-built formula: the decoding grammar's depth (the translator's
+#: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
+#: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
+PATTERN_MAX_DEPTH = 5
 SOURCE = "synthetic"
 
 
@@ -61,7 +72,8 @@ class SynthSettings:
     """What the generator draws.
 
     Args:
-        max_depth: Deepest operator nesting, 1..4.
+        max_depth: Deepest operator nesting of randomly grown formulas, 1..4
+            (pattern-built ones go to :data:`PATTERN_MAX_DEPTH`).
         max_props: Most distinct propositions per formula, 1..5.
         timed: Probability that a temporal operator carries an interval, in [0, 1].
         max_bound: Largest interval bound, >= 2 (the decoding grammar's is 1000).
@@ -106,6 +118,9 @@ def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) 
         lambda: Until(a, b, iv), lambda: Until(Not(a), b),
         lambda: Implies(a, Eventually(b, iv)), lambda: Eventually(a, iv),
         lambda: Always(Not(a), iv),
+        # Visits in any order (Menghi et al.'s "visit" mission pattern)
+        lambda: And((Eventually(a), Eventually(b))),
+        lambda: And((And((Eventually(a), Eventually(b))), Eventually(leaf()))),
     ]
     return rng.choice(choices)()
 
@@ -169,6 +184,7 @@ def sample_formula(rng: random.Random, s: SynthSettings, names: list[str]) -> Fo
         leaf = _leaf_drawer(rng, names)
         operand = _operand_drawer(rng, leaf)
         kind = rng.random()
+        deepest = PATTERN_MAX_DEPTH
         if kind < 0.4:
             f = _pattern(rng, s, operand)
         elif kind < 0.7:
@@ -181,7 +197,8 @@ def sample_formula(rng: random.Random, s: SynthSettings, names: list[str]) -> Fo
             f = And((And((p1, p2)), p3))
         else:
             f = _random(rng, s, leaf, rng.randint(2, s.max_depth))
-        if 1 <= depth(f) <= s.max_depth:
+            deepest = s.max_depth
+        if 1 <= depth(f) <= deepest:
             return f
 
 
@@ -219,6 +236,17 @@ def _word(f: Formula, rng: random.Random, mode: str, say, is_action) -> str:
                                say_atom=say, is_action=is_action))
 
 
+def conditions_of(f: Formula) -> frozenset[str]:
+    """The propositions a grounded sentence must say as conditions ("the door is
+    open"), not as commands: those read at the first instant, and those read at the
+    instant of an implication or equivalence (``a`` and ``b`` in ``G(a -> b)``). A
+    command there reads badly ("every time put down the bottle") or as a request for
+    later: a user's "whenever the light is green, put down the book" asks for
+    ``G(light_green -> F(place_book))``, which the response idiom words that way."""
+    triggered = (atoms_read_now(n) for n in walk(f) if isinstance(n, (Implies, Iff)))
+    return atoms_read_now(f).union(*triggered)
+
+
 def pair(rng: random.Random, s: SynthSettings, mode: str,
          want_held_out: bool) -> tuple[Formula, str, Formula, str] | None:
     """One row: (lifted formula, sentence, grounded formula, sentence), or ``None``
@@ -236,7 +264,7 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
         lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
     lifted = rename_atoms(f, lifted_names)
     lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
-    now = atoms_read_now(f)
+    now = conditions_of(f)
     props: list[Proposition] = draw_propositions(
         rng, len(used), conditions=frozenset(i for i, x in enumerate(used) if x in now))
     by_x = dict(zip(used, props, strict=True))

@@ -7,9 +7,11 @@ construct, a time unit and a sentence layout, so one formula becomes many senten
 
 Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
 often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, then b",
-``!a U b`` "do not a until b". Everything else is read compositionally, and a binary
-subformula under another operator is read in its bracketing form ("both ... and ...",
-"either ... or ...") so that the scope survives in the sentence.
+``!a U b`` "do not a until b"; in sampled sentences also ``F(a) & F(b)`` "a and b, in
+any order", and ``G(a -> F(b))`` with ``b`` a command "whenever a, b". Everything else
+is read compositionally, and a binary subformula under another operator is read in its
+bracketing form ("both ... and ...", "either ... or ...") so that the scope survives in
+the sentence.
 
 A few phrasings per construct are *held out* (:data:`HELD_OUT`): the compositional
 test split uses them and training never does, to measure whether a translator
@@ -84,6 +86,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "response": ("whenever {a}, eventually {b}", "every time {a}, {b} at some later point",
                  "each time {a}, make sure that eventually {b}", "if ever {a}, then eventually {b}",
                  "{a} is always followed by {b}", "any time {a}, sooner or later {b}"),
+    # Response with a command said on its own: "whenever the battery is low, go to the
+    # charging station" asks for it some time after, as a bare command at the top does.
+    "response_do": ("whenever {a}, {b}", "every time {a}, {b}", "each time {a}, {b} afterwards",
+                    "if ever {a}, {b} at some point after that", "{b} every time {a}"),
     "response_n": ("whenever {a}, {b} within {n} {u}",
                    "every time {a}, {b} within the next {n} {u}",
                    "each time {a}, {b} in at most {n} {u}",
@@ -95,11 +101,15 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "sequence": ("first {a}, then {b}", "{a} and after that {b}", "{a}, and afterwards {b}",
                  "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}",
                  "{a}, then {b}", "{a} first, and {b} afterwards", "after {a}, {b}",
-                 "{a}; once that is done, {b}"),
+                 "{a}; once that is done, {b}", "{a} and {b}, in that order"),
     "sequence3": ("first {a}, then {b}, then {c}", "{a}, then {b}, and finally {c}",
                   "{a}, after that {b}, and after that {c}", "{a}, then {b}, then {c}",
                   "in this order: {a}, {b}, {c}", "{a}, {b}, and then {c}",
-                  "first {a}, next {b}, and last {c}", "{a}, afterwards {b}, then {c}"),
+                  "first {a}, next {b}, and last {c}", "{a}, afterwards {b}, then {c}",
+                  "{a}, {b} and {c}, in that order"),
+    # F(a) & F(b) [& F(c)] at the top: each at some point, the order left open.
+    "visit_any": ("{l}, in any order", "{l} in any order", "{l}, in whatever order",
+                  "{l}, the order does not matter"),
     "avoid_until": ("do not {a} until {b}", "{a} must not happen before {b}",
                     "avoid {a} until {b}", "never {a} before {b}",
                     "wait until {b} before you {a}"),
@@ -143,10 +153,12 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "FG": frozenset({"{a} from some point on, forever"}),
     "GF": frozenset({"keep returning to {a} forever"}),
     "response": frozenset({"any time {a}, sooner or later {b}"}),
+    "response_do": frozenset({"{b} every time {a}"}),
     "response_n": frozenset({"whenever {a}, within {n} {u} {b}"}),
     "invariant": frozenset({"always, if {a}, then {b}"}),
     "sequence": frozenset({"{a}, followed by {b}"}),
     "sequence3": frozenset({"in this order: {a}, {b}, {c}"}),
+    "visit_any": frozenset({"{l}, the order does not matter"}),
     "U": frozenset({"continue {a} until {b}"}),
     "<->": frozenset({"{a} when and only when {b}"}),
     "|": frozenset({"{a}, or {b}"}),
@@ -230,6 +242,11 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
          now: bool = False) -> str:
     """``now``: ``f`` is read at the first instant (outside every temporal operator),
     where a bare command ("go to the kitchen") means "at some point"."""
+    visits = None if embedded or r.rng is None else _visits(f)
+    if visits is not None and r.rng.random() < 0.5:
+        said = [_say(g, r, used, embedded=True) for g in visits]
+        listing = " and ".join(said) if len(said) == 2 else f"{', '.join(said[:-1])} and {said[-1]}"
+        return r.pick("visit_any", used, l=listing)
     idiom = _idiom(f, r, used)
     if idiom is not None:
         return idiom
@@ -303,6 +320,9 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
         lhs, rhs = f.arg.lhs, f.arg.rhs
         if isinstance(rhs, Eventually) and (rhs.interval is None or
                                              (rhs.interval.lo == 0 and rhs.interval.hi)):
+            command = isinstance(rhs.arg, Atom) and r.is_action(rhs.arg.name)
+            if rhs.interval is None and command and r.rng is not None and r.rng.random() < 0.5:
+                return r.pick("response_do", used, a=sub(lhs), b=sub(rhs.arg))
             if rhs.interval is None:
                 return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
             return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
@@ -319,6 +339,22 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
         return r.pick("sequence3", used, a=sub(steps[0]), b=middle, c=last)
     if isinstance(f, Until) and f.interval is None and isinstance(f.lhs, Not):
         return r.pick("avoid_until", used, a=sub(f.lhs.arg), b=sub(f.rhs))
+    return None
+
+
+def _visits(f: Formula) -> list[Formula] | None:
+    """``F(a) & F(b) [& F(c)]`` over propositions (any bracketing) as ``[a, b(, c)]``,
+    else ``None``."""
+
+    def parts(g: Formula) -> list[Formula]:
+        return [p for arg in g.args for p in parts(arg)] if isinstance(g, And) else [g]
+
+    if not isinstance(f, And):
+        return None
+    found = parts(f)
+    if 2 <= len(found) <= 3 and all(isinstance(g, Eventually) and g.interval is None
+                                    and isinstance(g.arg, Atom) for g in found):
+        return [g.arg for g in found]
     return None
 
 

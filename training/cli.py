@@ -64,7 +64,10 @@ def export_cmd(
             from ara.data import load_split
 
             config = json.loads((run / "run.json").read_text())["config"]
-            records = load_split(config["data"]["split"], config["data"]["seed"]).records(
+            # The version the run trained on, which run.json records
+            data = json.loads((run / "run.json").read_text())["data"]
+            records = load_split(config["data"]["split"], config["data"]["seed"],
+                                 version=data["version"]).records(
                 "test", config["data"]["forms"][0])[:parity_pairs]
             export = run / "export"
             manifest["parity"] = parity(export / f"model-{outtype}.gguf", export / "merged-hf",

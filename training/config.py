@@ -7,6 +7,7 @@ the list of known ones instead of being ignored.
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
@@ -80,6 +81,9 @@ class DataSettings:
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``).
         seed: Seed the split was prepared with.
+        version: The split's prepared version (12 hex digits), pinned so that the run
+            can be repeated after the data changed; ``None``: the version this release
+            registers in ``data/versions.json``.
         forms: ``lifted``, ``grounded`` or both.
         limit: Use only the first N training records (``None``: all).
         shots: Worked examples per prompt. Each batch draws one count from this list
@@ -91,6 +95,7 @@ class DataSettings:
 
     split: str = "paper"
     seed: int = 0
+    version: str | None = None
     forms: tuple[str, ...] = ("lifted", "grounded")
     limit: int | None = None
     shots: tuple[int, ...] = (0,)
@@ -103,6 +108,9 @@ class DataSettings:
         bad = [f for f in self.forms if f not in ("lifted", "grounded")]
         if bad or not self.forms:
             raise ConfigError(f"data.forms must name lifted and/or grounded, got {self.forms}")
+        if self.version is not None and not re.fullmatch(r"[0-9a-f]{12}", str(self.version)):
+            raise ConfigError(f"data.version must be 12 hex digits (a prepared version, "
+                              f"see data/versions.json) or null, got {self.version!r}")
         if self.limit is not None and self.limit < 1:
             raise ConfigError(f"data.limit must be >= 1 or null, got {self.limit}")
 

@@ -99,7 +99,15 @@ class LoRAFinetuneRecipe:
     def _load_data(self):
         from ara.data import load_split
 
-        split = load_split(self.config.data.split, self.config.data.seed)
+        data = self.config.data
+        split = load_split(data.split, data.seed, version=data.version)
+        if self.resume and self.out.joinpath("run.json").exists():
+            started = json.loads(self.out.joinpath("run.json").read_text())["data"]["version"]
+            if started != split.version:
+                raise ConfigError(
+                    f"--resume: {self.out} was started on {data.split} version {started}, "
+                    f"but this release loads {split.version}; pin data.version: {started} "
+                    "in the config")
         records = [r for f in self.config.data.forms for r in split.records("train", f)]
         if self.config.data.limit:
             records = records[: self.config.data.limit]
@@ -294,9 +302,14 @@ def _warm_started(base, folder: str, lora):
 
     model = PeftModel.from_pretrained(base, folder, is_trainable=True)
     saved = model.peft_config["default"]
-    mismatched = {name: (got, want) for name, got, want in (
-        ("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha))
-        if got != want}
+    checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha),
+              ("dropout", saved.lora_dropout, lora.dropout)]
+    # A saved adapter lists the modules "all-linear" resolved to, so only an explicit
+    # list in the config can be compared with it.
+    if lora.target_modules != "all-linear":
+        checks.append(("target_modules", sorted(saved.target_modules),
+                       sorted(lora.target_modules)))
+    mismatched = {name: (got, want) for name, got, want in checks if got != want}
     if mismatched:
         detail = ", ".join(f"{k}: adapter {g} vs config {w}" for k, (g, w) in mismatched.items())
         raise ConfigError(f"init_adapter {folder} has another LoRA shape ({detail}); "

@@ -86,6 +86,9 @@ def test_unprepared_and_unknown_splits_say_what_to_run(tmp_path):
     """Tests the messages for a split never prepared and a misspelt split name."""
     with pytest.raises(DataVersionError, match="ara data prepare --split paper --seed 3"):
         load_split("paper", 3, tmp_path, version="abc")
+    # An older version of a registered split is made by the release that registered it
+    with pytest.raises(DataVersionError, match="git log -p data/versions.json"):
+        load_split("paper", 0, tmp_path, version="0123456789ab")
     with pytest.raises(ConfigError, match="Did you mean 'disjoint'"):
         prepare("disjoin", 0, tmp_path)
 

@@ -8,6 +8,7 @@ from collections import Counter
 import pytest
 
 from ara.data.synthetic import (
+    PATTERN_MAX_DEPTH,
     SynthSettings,
     is_held_out,
     sample_formula,
@@ -25,8 +26,15 @@ from ara.grammars.ast import (
     Until,
     atoms_read_now,
     depth,
+    rename_atoms,
     walk,
 )
+
+
+def rename_in_order(f):
+    """``f`` over x, y, z, ... in order of first occurrence."""
+    order = list(dict.fromkeys(n.name for n in walk(f) if hasattr(n, "name")))
+    return rename_atoms(f, dict(zip(order, "xyzuvw", strict=False)))
 
 
 @pytest.fixture(scope="module")
@@ -55,8 +63,19 @@ def test_every_operator_and_both_forms_occur(train_records):
 def test_records_fit_the_decoding_grammar(train_records):
     """Tests that every reference is writable under the translator's grammar."""
     for r in train_records:
-        assert depth(r.formula) <= 4
+        assert depth(r.formula) <= PATTERN_MAX_DEPTH
         assert Syntax(aps=r.aps, intervals=True, max_depth=5, max_args=2).accepts(r.stl)
+
+
+def test_three_step_sequences_and_visits_in_any_order_are_drawn(train_records):
+    """Tests that the patterns users write most are there, each in a few wordings:
+    F(a & F(b & F(c))) is depth 5, which a depth limit of 4 once rejected silently."""
+    three_steps = [r for r in train_records
+                   if parse("F(x & F(y & F(z)))") == rename_in_order(r.formula)]
+    assert len(three_steps) >= 10
+    assert len({r.nl.split(" ")[0] for r in three_steps}) > 3
+    assert any("in any order" in r.nl for r in train_records)
+    assert any("in that order" in r.nl for r in train_records)
 
 
 def test_lifted_and_grounded_records_of_a_row_share_their_shape(train_records):
@@ -81,6 +100,20 @@ def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
     read_now = [name for r in grounded for name in atoms_read_now(r.formula)]
     assert len(read_now) > 50  # conditions do occur there (if a then ..., a <-> ...)
     assert not [name for name in read_now if name.startswith(ACTION_PREFIXES)]
+
+
+def test_grounded_rows_say_a_triggered_proposition_as_a_condition(train_records):
+    """Tests that "whenever the light is green, put down the book" is never labelled
+    G(light_green -> place_book): a command after "whenever" asks for it later, so a
+    proposition read at the instant of an implication is a condition."""
+    grounded = [r for r in train_records if r.form == "grounded"]
+    triggered = [name for r in grounded for n in walk(r.formula)
+                 if isinstance(n, (Implies, Iff)) for name in atoms_read_now(n)]
+    assert len(triggered) > 50
+    assert not [name for name in triggered if name.startswith(ACTION_PREFIXES)]
+    # The response to a command is said the way users say it
+    assert any(r.nl.lower().startswith(("whenever", "every time")) and "eventually"
+               not in r.nl and isinstance(r.formula, Always) for r in grounded)
 
 
 def test_held_out_shapes_stay_on_the_test_side(train_records):
@@ -124,6 +157,7 @@ def test_the_compositional_split_keeps_its_test_side_and_nl2tl_dev_out_of_traini
     shape in train. (navi itself shares 19 sentences with that dev file; the timed
     evaluation reports the pairs unseen in training apart for that reason.)"""
     from ara.data import load_or_prepare
+    from ara.data.handwritten import suite_records
 
     split = load_or_prepare("compositional", 0)
     train, test = split.records("train"), split.records("test")
@@ -134,5 +168,10 @@ def test_the_compositional_split_keeps_its_test_side_and_nl2tl_dev_out_of_traini
     assert not [r for r in train if r.source == "navi" and r.form == "grounded"]
     assert not {shape(r.formula) for r in test} & {shape(r.formula) for r in train}
     assert not {r.nl for r in test} & {r.nl for r in train}
+    # The hand-written suite is never trained on, not even a short sentence the
+    # generator happens to say the same way
+    said = {" ".join(r.nl.lower().rstrip(". ").split()) for r in train}
+    assert not [r.nl for r in suite_records()
+                if " ".join(r.nl.lower().rstrip(". ").split()) in said]
     assert all(any(isinstance(n, k) for r in train for n in walk(r.formula))
                for k in (Implies, Iff, Not))

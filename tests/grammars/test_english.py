@@ -93,6 +93,23 @@ def test_a_command_said_on_its_own_means_at_some_point():
     assert "go to the kitchen" not in nested
 
 
+def test_sampled_wordings_say_visits_in_any_order_and_responses_as_commands():
+    """Tests two idioms of sampled sentences (explain keeps the compositional
+    reading): F(a) & F(b) as "a and b, in any order", and G(c -> F(a)) with ``a`` a
+    command as "whenever c, a", the way a user asks for a later reaction."""
+    said = {"go": "go to the kitchen", "pick": "pick up the cup", "low": "the battery is low"}
+    realizer = Realizer(rng=random.Random(0), mode="train", say_atom=said.__getitem__,
+                        is_action=lambda name: name != "low")
+    visits = {realize(parse("F(go) & F(pick)"), realizer).rstrip(".") for _ in range(100)}
+    assert "go to the kitchen and pick up the cup, in any order" in {s.lower() for s in visits}
+    assert explain(parse("F(a) & F(b)")) == "eventually a, and eventually b"
+    assert "in any order" not in explain(parse("G(F(a) & F(b))"))
+    responses = {realize(parse("G(low -> F(go))"), realizer).rstrip(".").lower()
+                 for _ in range(100)}
+    assert "whenever the battery is low, go to the kitchen" in responses
+    # (the generator keeps commands out of G(c -> a), which this wording would also fit)
+
+
 def test_realizer_settings_are_checked():
     """Tests that a bad mode or unit is refused where the realizer is built."""
     with pytest.raises(ConfigError, match="mode must be one of"):

@@ -29,6 +29,7 @@ def test_shipped_configs_load_and_round_trip(path):
         ({"lora": 3}, "lora must be a mapping"),
         ({"data": {"shots": [0, -5]}}, "counts >= 0"),
         ({"data": {"shots": []}}, "counts >= 0"),
+        ({"data": {"version": "v3"}}, "12 hex digits"),
     ],
 )
 def test_bad_configs_say_what_is_wrong(data, message):
