@@ -12,14 +12,16 @@ learned. A formula has 1 to 5 propositions, and one may occur twice. Each row is
 twice: lifted (``prop_1``...) and grounded (``go_to_kitchen``...).
 
 In grounded form a proposition read at the first instant only (``a`` in ``a -> F(b)``),
-or at the instant of an implication (``a`` and ``b`` in ``G(a -> b)``), is a condition
-("the door is open"), never an action: a command said on its own ("go to the
-kitchen") means *at some point*, and is written ``F(go_to_kitchen)``.
+or at the instant of an antecedent (``a`` in ``G(a -> b)``), is a condition ("the door
+is open"), never an action; at the instant of a consequent (``b`` there) it is a
+condition or a lasting action ("hold the box"), never an achievement: a command said
+on its own ("go to the kitchen") means *at some point*, and is written
+``F(go_to_kitchen)``.
 
 Version 3 (after reading the shipped fine-tune's misses, docs/generalization.md) draws
 three-step sequences, which version 2's depth limit of 4 had silently rejected, says
-conditions where version 2 said commands after "whenever", and adds the visit pattern
-and "in that order" / "in any order".
+conditions or lasting actions where version 2 said any command around "whenever", and
+adds the visit pattern and "in that order" / "in any order".
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -231,20 +233,32 @@ def _lifted_atom(rng: random.Random) -> Callable[[str], str]:
     return style.format
 
 
-def _word(f: Formula, rng: random.Random, mode: str, say, is_action) -> str:
+def _word(f: Formula, rng: random.Random, mode: str, say, is_action,
+          is_lasting=lambda name: False) -> str:
     return realize(f, Realizer(rng=rng, mode=mode, unit=rng.randrange(len(UNITS)),
-                               say_atom=say, is_action=is_action))
+                               say_atom=say, is_action=is_action, is_lasting=is_lasting))
 
 
-def conditions_of(f: Formula) -> frozenset[str]:
-    """The propositions a grounded sentence must say as conditions ("the door is
-    open"), not as commands: those read at the first instant, and those read at the
-    instant of an implication or equivalence (``a`` and ``b`` in ``G(a -> b)``). A
-    command there reads badly ("every time put down the bottle") or as a request for
-    later: a user's "whenever the light is green, put down the book" asks for
-    ``G(light_green -> F(place_book))``, which the response idiom words that way."""
-    triggered = (atoms_read_now(n) for n in walk(f) if isinstance(n, (Implies, Iff)))
-    return atoms_read_now(f).union(*triggered)
+def conditions_of(f: Formula) -> tuple[frozenset[str], frozenset[str]]:
+    """What a grounded sentence must say as a condition ("the door is open") rather
+    than as a command, and what it may say as a lasting action ("hold the box").
+
+    Conditions: the propositions read at the first instant, and those read at the
+    instant of an antecedent or of an equivalence (``a`` in ``G(a -> b)``). States:
+    those read at the instant of a consequent (``b`` in ``G(a -> b)``), which a lasting
+    action may be ("whenever the alarm is on, wait") but an achievement may not: a
+    user's "whenever the light is green, put down the book" asks for
+    ``G(light_green -> F(place_book))``, which the response idiom words that way, and
+    "every time put down the bottle, ..." reads badly.
+    """
+    conditions, states = set(atoms_read_now(f)), set()
+    for n in walk(f):
+        if isinstance(n, Iff):
+            conditions |= atoms_read_now(n)
+        elif isinstance(n, Implies):
+            conditions |= atoms_read_now(n.lhs)
+            states |= atoms_read_now(n.rhs)
+    return frozenset(conditions), frozenset(states - conditions)
 
 
 def pair(rng: random.Random, s: SynthSettings, mode: str,
@@ -264,15 +278,17 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
         lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
     lifted = rename_atoms(f, lifted_names)
     lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
-    now = conditions_of(f)
+    conditions, states = conditions_of(f)
     props: list[Proposition] = draw_propositions(
-        rng, len(used), conditions=frozenset(i for i, x in enumerate(used) if x in now))
+        rng, len(used), conditions=frozenset(i for i, x in enumerate(used) if x in conditions),
+        states=frozenset(i for i, x in enumerate(used) if x in states))
     by_x = dict(zip(used, props, strict=True))
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}
     phrase = {p.name: rng.choice(p.phrases) for p in props}
     grounded_nl = _word(grounded, rng, mode, phrase.__getitem__,
-                        lambda name: by_name[name].action)
+                        lambda name: by_name[name].action,
+                        lambda name: by_name[name].lasting)
     return lifted, lifted_nl, grounded, grounded_nl
 
 

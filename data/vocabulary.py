@@ -73,17 +73,44 @@ class Proposition:
     name: str
     phrases: tuple[str, ...]
     action: bool
+    #: An action that is a state while it lasts ("hold the box", "stay at the dock",
+    #: "wait"): after "whenever c" it asks for that state then, not at some later point.
+    lasting: bool = False
 
 
-def draw_propositions(rng: random.Random, k: int,
-                      conditions: frozenset[int] = frozenset()) -> list[Proposition]:
+#: Verbs of lasting actions (see :attr:`Proposition.lasting`).
+LASTING_VERBS = frozenset({"at", "hold", "wait"})
+
+
+def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = frozenset(),
+                      states: frozenset[int] = frozenset()) -> list[Proposition]:
     """``k`` propositions with distinct names, mixing actions and conditions; the ones
-    at the indices in ``conditions`` are conditions."""
+    at the indices in ``conditions`` are conditions, those in ``states`` a condition or
+    a lasting action, half and half."""
     found: dict[str, Proposition] = {}
     while len(found) < k:
-        prop = _draw_condition(rng) if len(found) in conditions else _draw_one(rng)
+        i = len(found)
+        if i in conditions:
+            prop = _draw_condition(rng)
+        elif i in states:
+            prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_lasting(rng)
+        else:
+            prop = _draw_one(rng)
         found.setdefault(prop.name, prop)
     return list(found.values())
+
+
+def _draw_lasting(rng: random.Random) -> Proposition:
+    kind = rng.random()
+    if kind < 0.45:
+        phrases = dict(PLACE_VERBS)["at"]
+        name, words = _thing(rng, PLACES, NUMBERED_PLACES)
+        return _about("at", phrases, name, words, action=True)
+    if kind < 0.9:
+        phrases = dict(OBJECT_VERBS)["hold"]
+        name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+        return _about("hold", phrases, name, words, action=True)
+    return Proposition("wait", dict(STANDALONE_ACTIONS)["wait"], action=True, lasting=True)
 
 
 def _draw_condition(rng: random.Random) -> Proposition:
@@ -110,7 +137,7 @@ def _draw_one(rng: random.Random) -> Proposition:
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
     elif kind < 0.86:
         verb, phrases = rng.choice(STANDALONE_ACTIONS)
-        return Proposition(verb, phrases, action=True)
+        return Proposition(verb, phrases, action=True, lasting=verb in LASTING_VERBS)
     else:
         name, phrases = rng.choice(CONDITIONS)
         return Proposition(name, phrases, action=False)
@@ -121,7 +148,7 @@ def _about(verb: str, phrases: tuple[str, ...], name: str, words: str,
            action: bool) -> Proposition:
     """``verb_name``, said by each phrasing with the thing's words filled in."""
     filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
-    return Proposition(f"{verb}_{name}", filled, action)
+    return Proposition(f"{verb}_{name}", filled, action, lasting=action and verb in LASTING_VERBS)
 
 
 def _thing(rng: random.Random, plain, numbered) -> tuple[str, str]:

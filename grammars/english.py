@@ -183,6 +183,9 @@ class Realizer:
         say_atom: How a proposition is said (``prop_1`` -> ``(prop_1)``, or
             ``go_to_kitchen`` -> ``go to the kitchen``).
         is_action: Whether a proposition reads as an imperative ("do not go ...").
+        is_lasting: Whether an action is a state while it lasts ("hold the box"):
+            "whenever c, hold the box" asks for it then, so the response idiom
+            ``G(c -> F(b))`` never says such a ``b`` as the bare command.
     """
 
     rng: random.Random | None = None
@@ -190,6 +193,7 @@ class Realizer:
     unit: int = 0
     say_atom: Callable[[str], str] = field(default=lambda name: name)
     is_action: Callable[[str], bool] = field(default=lambda name: False)
+    is_lasting: Callable[[str], bool] = field(default=lambda name: False)
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -320,7 +324,8 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
         lhs, rhs = f.arg.lhs, f.arg.rhs
         if isinstance(rhs, Eventually) and (rhs.interval is None or
                                              (rhs.interval.lo == 0 and rhs.interval.hi)):
-            command = isinstance(rhs.arg, Atom) and r.is_action(rhs.arg.name)
+            command = isinstance(rhs.arg, Atom) and r.is_action(rhs.arg.name) \
+                and not r.is_lasting(rhs.arg.name)
             if rhs.interval is None and command and r.rng is not None and r.rng.random() < 0.5:
                 return r.pick("response_do", used, a=sub(lhs), b=sub(rhs.arg))
             if rhs.interval is None:

@@ -3,13 +3,19 @@
 
     .venv/bin/python scripts/generalization_table.py [--results docs/results/generalization]
 
+    .venv/bin/python scripts/generalization_table.py --test compositional=2cc898a81b54
+
 A cell is accuracy / validity in % over all pairs of the run (invalid and undecided
 answers count as wrong). ``unseen`` is the accuracy on the pairs whose sentence does
-not occur in that model's own training data, the figure that says what a user's new
-sentence can expect; the paper split's lifted test side is almost all seen. A run
-whose pairs are not all pairs of the registered test data (the timed dev file's labels
-were corrected in timed version 5f389aa2c4b4) is left out and listed. Writes
-``summary.json`` beside the runs.
+not occur in that model's own training data (the data version it trained on, where
+that version is prepared on this machine; else the current one, and the output says
+so), the figure that says what a user's new sentence can expect; the paper split's
+lifted test side is almost all seen. A run whose pairs are not all pairs of the test
+data (the registered version, or the one ``--test SPLIT=VERSION`` names) is left out
+and listed: the timed dev file's labels were corrected in timed version 5f389aa2c4b4,
+and each version of the compositional mixture has its own test side (a run on an
+earlier one lives in ``<set>-<form>@<version>``). Writes ``summary.json`` beside the
+runs.
 """
 
 from __future__ import annotations
@@ -22,14 +28,20 @@ from collections import defaultdict
 from datetime import date
 from pathlib import Path
 
-#: Results folder -> (label, the split the model trained on or None).
+#: Results folder -> (label, (split, data version) the model trained on, or None).
 MODELS = {
     "base-270m": ("base", None),
-    "paper-adapter-270m": ("paper adapter (old)", "paper"),
-    "compositional-adapter-v1-270m": ("compositional adapter v1", "compositional"),
-    "compositional-adapter-v2-270m": ("compositional adapter v2", "compositional"),
-    "compositional-adapter-v3-270m": ("compositional adapter v3", "compositional"),
-    "compositional-adapter-270m": ("compositional adapter v4 (shipped)", "compositional"),
+    "paper-adapter-270m": ("paper adapter (old)", ("paper", "1de1d813ead6")),
+    "compositional-adapter-v1-270m": ("compositional adapter v1",
+                                      ("compositional", "7694e7d55174")),
+    "compositional-adapter-v2-270m": ("compositional adapter v2",
+                                      ("compositional", "c3c2564014d2")),
+    "compositional-adapter-v3-270m": ("compositional adapter v3",
+                                      ("compositional", "2cc898a81b54")),
+    "compositional-adapter-270m": ("compositional adapter v4 (shipped)",
+                                   ("compositional", "2cc898a81b54")),
+    "compositional-adapter-v5-270m": ("compositional adapter v5 (not shipped)",
+                                      ("compositional", "2cc898a81b54")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),
@@ -37,12 +49,20 @@ SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
 VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]
 
 
-def training_sentences(split: str | None) -> set[str]:
-    if split is None:
+def training_sentences(trained_on: tuple[str, str] | None, notes: list[str]) -> set[str]:
+    if trained_on is None:
         return set()
-    from ara.data import load_or_prepare
+    from ara.data import load_or_prepare, load_split
+    from ara.errors import DataVersionError
 
-    return {r.nl for r in load_or_prepare(split, 0).records("train")}
+    split, version = trained_on
+    try:
+        data = load_split(split, 0, version=version)
+    except DataVersionError:
+        data = load_or_prepare(split, 0)
+        notes.append(f"{split} {version} is not prepared here: 'unseen' counted against "
+                     f"{data.version}")
+    return {r.nl for r in data.records("train")}
 
 
 def cell(samples: list[dict], seen: set[str]) -> dict:
@@ -58,22 +78,33 @@ def cell(samples: list[dict], seen: set[str]) -> dict:
     }
 
 
-def collect(results: Path) -> tuple[dict, list[str]]:
-    """The table, and the runs left out because their test data is not the current."""
-    from ara.data import load_or_prepare
+def collect(results: Path, test_versions: dict[str, str] | None = None
+            ) -> tuple[dict, list[str], list[str]]:
+    """The table, the runs left out because their test data is not the one chosen
+    (``test_versions``: split -> version; the registered one otherwise), and notes."""
+    from ara.data import load_or_prepare, load_split
+
+    def test_side(split: str):
+        version = (test_versions or {}).get(split)
+        data = load_split(split, 0, version=version) if version else load_or_prepare(split, 0)
+        return data.version, {(r.nl, r.stl) for r in data.records("test")}
 
     table: dict = defaultdict(dict)
     stale: list[str] = []
-    current = {split: {(r.nl, r.stl) for r in load_or_prepare(split, 0).records("test")}
-               for split in {split for split, _ in SETS}}
+    notes: list[str] = []
+    current = {split: test_side(split) for split in {split for split, _ in SETS}}
     for folder, (_, trained_on) in MODELS.items():
-        seen = training_sentences(trained_on)
+        seen = training_sentences(trained_on, notes)
         for split, form in SETS:
-            path = results / folder / f"{split}-{form}" / "samples.jsonl"
-            if not path.exists():
+            version, pairs = current[split]
+            # A run on an earlier version of the test data keeps it in its folder name
+            found = [results / folder / f"{split}-{form}{suffix}" / "samples.jsonl"
+                     for suffix in (f"@{version}", "")]
+            path = next((p for p in found if p.exists()), None)
+            if path is None:
                 continue
             samples = [json.loads(line) for line in path.read_text().splitlines()]
-            if any((s["nl"], s["reference"]) not in current[split] for s in samples):
+            if any((s["nl"], s["reference"]) not in pairs for s in samples):
                 version = json.loads(path.with_name("run.json").read_text())["data"]["version"]
                 stale.append(f"{folder}/{split}-{form} (data {version})")
                 continue
@@ -82,7 +113,7 @@ def collect(results: Path) -> tuple[dict, list[str]]:
                 by_variant[(s["variant"], s["shots"])].append(s)
             for key, samples in by_variant.items():
                 table[(split, form, *key)][folder] = cell(samples, seen)
-    return table, stale
+    return table, stale, notes
 
 
 def markdown(table: dict) -> str:
@@ -113,18 +144,27 @@ def markdown(table: dict) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, default=Path("docs/results/generalization"))
+    parser.add_argument("--test", action="append", default=[], metavar="SPLIT=VERSION",
+                        help="compare on this prepared version of a split's test side "
+                             "(default: the registered one); repeatable")
     args = parser.parse_args()
-    table, stale = collect(args.results)
+    try:
+        test_versions = dict(item.split("=", 1) for item in args.test)
+    except ValueError:
+        parser.error(f"--test takes SPLIT=VERSION, got {args.test}")
+    table, stale, notes = collect(args.results, test_versions)
     print(markdown(table))
     print("\nCells: accuracy / validity in %; (unseen ...): accuracy on the pairs whose "
           "sentence is not in that model's training data.")
     if stale:
         print("Left out, made on another version of their test data: " + ", ".join(stale))
+    for note in dict.fromkeys(notes):
+        print(note)
     summary = {"date": date.today().isoformat(), "machine": platform.platform(),
                "cells": [{"set": k[0], "form": k[1], "variant": k[2], "shots": k[3],
                           "model": m, **c} for k, row in sorted(table.items())
                          for m, c in row.items()],
-               "left_out": stale}
+               "test_versions": test_versions, "left_out": stale, "notes": notes}
     (args.results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
 
 

@@ -108,6 +108,12 @@ def test_sampled_wordings_say_visits_in_any_order_and_responses_as_commands():
                  for _ in range(100)}
     assert "whenever the battery is low, go to the kitchen" in responses
     # (the generator keeps commands out of G(c -> a), which this wording would also fit)
+    # A lasting action said bare after "whenever" asks for it then: never for F
+    lasting = Realizer(rng=random.Random(0), mode="train", say_atom=said.__getitem__,
+                       is_action=lambda name: name != "low",
+                       is_lasting=lambda name: name == "go")
+    assert not {realize(parse("G(low -> F(go))"), lasting).rstrip(".").lower()
+                for _ in range(100)} & {"whenever the battery is low, go to the kitchen"}
 
 
 def test_realizer_settings_are_checked():
