@@ -42,7 +42,7 @@ MODELS = {
                                    ("compositional", "2cc898a81b54")),
     "compositional-adapter-v5-270m": ("compositional adapter v5 (not shipped)",
                                       ("compositional", "2cc898a81b54")),
-    "compositional-adapter-v6-270m": ("compositional adapter v6 (candidate)",
+    "compositional-adapter-v6-270m": ("compositional adapter v6 (not shipped)",
                                       ("compositional", "820c2d11c0c8")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
