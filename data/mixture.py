@@ -67,7 +67,7 @@ def _dedup(records: list[Record]) -> list[Record]:
     return out
 
 
-def _sentence_key(nl: str) -> str:
+def sentence_key(nl: str) -> str:
     """A sentence up to case, spacing and a final full stop."""
     return " ".join(nl.lower().rstrip(". ").split())
 
@@ -92,8 +92,8 @@ def compositional_split(raw_dir: Path, seed: int
     train = (nl2tl + synthetic_records(SYNTHETIC_TRAIN_ROWS, seed, held_out=False,
                                        settings=settings)
              + help_request_records(HELP_REQUEST_ROWS, seed))
-    suite = {_sentence_key(r.nl) for r in suite_records()}
-    train = [r for r in train if _sentence_key(r.nl) not in suite]
+    suite = {sentence_key(r.nl) for r in suite_records()}
+    train = [r for r in train if sentence_key(r.nl) not in suite]
     test = synthetic_records(SYNTHETIC_TEST_ROWS, seed, held_out=True, settings=settings)
     sources = {name: sha256_file(raw_dir / name)
                for name in ("navi.jsonl", "lifted_stl_train.jsonl")}

@@ -188,7 +188,8 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
         raise ConfigError(f"unknown split {split!r}. {did_you_mean(split, SPLITS)}")
     root = root or default_root()
     key = _key(split, None if split in UNSEEDED else seed)
-    version = version or registered_versions().get(key)
+    registered = registered_versions().get(key)
+    version = version or registered
     if version is None:
         found = sorted(root.glob(f"{key}-*"))
         if len(found) != 1:
@@ -199,7 +200,6 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
         folder = found[0]
     else:
         folder = root / f"{key}-{version}"
-    registered = registered_versions().get(key)
     if not folder.is_dir() and registered is not None and version != registered:
         raise DataVersionError(
             f"split {key} version {version} is not prepared in {root}, and this release "

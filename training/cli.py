@@ -63,11 +63,11 @@ def export_cmd(
         if parity_pairs:
             from ara.data import load_split
 
-            config = json.loads((run / "run.json").read_text())["config"]
+            saved = json.loads((run / "run.json").read_text())
+            config = saved["config"]
             # The version the run trained on, which run.json records
-            data = json.loads((run / "run.json").read_text())["data"]
             records = load_split(config["data"]["split"], config["data"]["seed"],
-                                 version=data["version"]).records(
+                                 version=saved["data"]["version"]).records(
                 "test", config["data"]["forms"][0])[:parity_pairs]
             export = run / "export"
             manifest["parity"] = parity(export / f"model-{outtype}.gguf", export / "merged-hf",

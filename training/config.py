@@ -129,6 +129,9 @@ class TrainConfig:
             schedule, for a second pass or new data. Its LoRA shape must match ``lora``.
         max_steps: Stop after this many optimizer steps (``None``: the epochs decide).
         checkpoint_every: Save a resumable checkpoint every N steps, >= 1.
+        keep_checkpoints: How many of the newest checkpoints to keep, >= 1. Each holds
+            the whole model state (about 1 GB for the 270M), so keeping all of them
+            fills a disk over a few runs.
         eval_pairs: Test pairs for the held-out check at the end (0: none).
         lora, optim, data: Sub-configs (see each).
     """
@@ -139,6 +142,7 @@ class TrainConfig:
     init_adapter: str | None = None
     max_steps: int | None = None
     checkpoint_every: int = 100
+    keep_checkpoints: int = 2
     eval_pairs: int = 100
     lora: LoraSettings = field(default_factory=LoraSettings)
     optim: OptimSettings = field(default_factory=OptimSettings)
@@ -147,8 +151,9 @@ class TrainConfig:
     def __post_init__(self) -> None:
         if self.max_steps is not None and self.max_steps < 1:
             raise ConfigError(f"max_steps must be >= 1 or null, got {self.max_steps}")
-        if self.checkpoint_every < 1 or self.eval_pairs < 0:
-            raise ConfigError("checkpoint_every must be >= 1 and eval_pairs >= 0")
+        if self.checkpoint_every < 1 or self.eval_pairs < 0 or self.keep_checkpoints < 1:
+            raise ConfigError("checkpoint_every and keep_checkpoints must be >= 1, "
+                              "eval_pairs >= 0")
         if self.init_adapter is not None and not str(self.init_adapter).strip():
             raise ConfigError("init_adapter must be an adapter folder or null, got ''")
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import random
+import shutil
 import time
 from pathlib import Path
 
@@ -233,17 +234,26 @@ class LoRAFinetuneRecipe:
 
     # -- checkpoints ----------------------------------------------------------------
     def save_checkpoint(self) -> Path:
-        """Adapter, optimizer, scheduler and RNG state at the current step."""
+        """Adapter, optimizer, scheduler and RNG state at the current step; then the
+        oldest checkpoints beyond ``keep_checkpoints`` go (only once the new one is whole,
+        so an interruption never leaves the run without one)."""
         folder = self.out / "checkpoints" / f"step_{self.step}"
         self.accelerator.save_state(str(folder))
         if self.accelerator.is_main_process:
             folder.joinpath("step.json").write_text(json.dumps({"step": self.step}))
+            for old in self._checkpoints()[:-self.config.keep_checkpoints]:
+                shutil.rmtree(old)
         self.accelerator.wait_for_everyone()
         return folder
 
+    def _checkpoints(self) -> list[Path]:
+        """Whole checkpoints (``step.json`` is written last), oldest first."""
+        return sorted((p for p in (self.out / "checkpoints").glob("step_*")
+                       if p.joinpath("step.json").is_file()),
+                      key=lambda p: int(p.name.split("_")[1]))
+
     def _load_checkpoint(self) -> None:
-        found = sorted((self.out / "checkpoints").glob("step_*"),
-                       key=lambda p: int(p.name.split("_")[1]))
+        found = self._checkpoints()
         if not found:
             raise ConfigError(f"--resume: no checkpoint in {self.out / 'checkpoints'}")
         self.accelerator.load_state(str(found[-1]))
@@ -290,8 +300,8 @@ class LoRAFinetuneRecipe:
 
 
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
-#: how often it checkpoints, and the held-out check at its end.
-_RESUMABLE_KEYS = {"max_steps", "eval_pairs", "checkpoint_every"}
+#: how often it checkpoints and how many it keeps, and the held-out check at its end.
+_RESUMABLE_KEYS = {"max_steps", "eval_pairs", "checkpoint_every", "keep_checkpoints"}
 
 
 def _warm_started(base, folder: str, lora):
@@ -345,8 +355,8 @@ def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
         detail = ", ".join(f"{k}: {saved.get(k)!r} -> {now.get(k)!r}" for k in changed)
         raise ConfigError(
             f"--resume: the config differs from the one {run_json.parent} was started with "
-            f"({detail}); resume with the same config (only max_steps, checkpoint_every and "
-            "eval_pairs may change), or train into another out folder")
+            f"({detail}); resume with the same config (only max_steps, checkpoint_every, "
+            "keep_checkpoints and eval_pairs may change), or train into another out folder")
 
 
 def main(config_path: str, max_steps: int | None = None, resume: bool = False) -> dict:

@@ -30,6 +30,7 @@ def test_shipped_configs_load_and_round_trip(path):
         ({"data": {"shots": [0, -5]}}, "counts >= 0"),
         ({"data": {"shots": []}}, "counts >= 0"),
         ({"data": {"version": "v3"}}, "12 hex digits"),
+        ({"keep_checkpoints": 0}, "keep_checkpoints must be >= 1"),
     ],
 )
 def test_bad_configs_say_what_is_wrong(data, message):

@@ -28,14 +28,14 @@ def tiny_config(model_dir, out, **overrides):
 
 def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_path):
     """Tests training on 8 pairs (2 batches, repeated over epochs): the loss falls,
-    checkpoints appear, and a resumed run picks up at the saved step."""
-    config = tiny_config(tiny_gemma_dir, tmp_path / "run",
+    only the newest checkpoint is kept, and a resumed run picks up at its step."""
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", keep_checkpoints=1,
                          optim={"lr": 5e-3, "batch_size": 4, "warmup_steps": 0, "epochs": 10})
     recipe = LoRAFinetuneRecipe(config)
     recipe.setup()
     losses = recipe.train()
     assert len(losses) == 6 and losses[-1] < losses[0]
-    assert (tmp_path / "run" / "checkpoints" / "step_6").is_dir()
+    assert [p.name for p in (tmp_path / "run" / "checkpoints").iterdir()] == ["step_6"]
     log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]
     assert [x["step"] for x in log] == list(range(1, 7)) and log[0]["tokens_per_s"] > 0
     run = json.loads((tmp_path / "run" / "run.json").read_text())
