@@ -16,12 +16,16 @@ or at the instant of an antecedent (``a`` in ``G(a -> b)``), is a condition ("th
 is open"), never an action; at the instant of a consequent (``b`` there) it is a
 condition or a lasting action ("hold the box"), never an achievement: a command said
 on its own ("go to the kitchen") means *at some point*, and is written
-``F(go_to_kitchen)``.
+``F(go_to_kitchen)``. The one exception is the trigger of a response or an invariant,
+``G(a -> ...)`` with ``a`` alone: there an achievement may be said as an event
+("whenever you pick up the red box, ...").
 
 Version 3 (after reading the shipped fine-tune's misses, docs/generalization.md) draws
 three-step sequences, which version 2's depth limit of 4 had silently rejected, says
 conditions or lasting actions where version 2 said any command around "whenever", and
-adds the visit pattern and "in that order" / "in any order".
+adds the visit pattern and "in that order" / "in any order". Version 3.1 brings back
+actions as triggers, said as events (3.0 left none, and the fine-tune on it wrote
+``F(pick -> F(place))`` for the help request), and "stop" as a lasting action.
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -32,6 +36,7 @@ from __future__ import annotations
 
 import hashlib
 import random
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -61,7 +66,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.0.0"
+SYNTHETIC_VERSION = "3.1.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -239,9 +244,22 @@ def _word(f: Formula, rng: random.Random, mode: str, say, is_action,
                                say_atom=say, is_action=is_action, is_lasting=is_lasting))
 
 
-def conditions_of(f: Formula) -> tuple[frozenset[str], frozenset[str]]:
-    """What a grounded sentence must say as a condition ("the door is open") rather
-    than as a command, and what it may say as a lasting action ("hold the box").
+@dataclass(frozen=True)
+class Roles:
+    """How a grounded sentence may say each proposition of a formula (see
+    :func:`roles_of`)."""
+
+    #: Said as a condition ("the door is open"), never as a command.
+    conditions: frozenset[str]
+    #: A condition or a lasting action ("hold the box"), never an achievement.
+    states: frozenset[str]
+    #: A condition or an achievement said as an event ("you pick up the box").
+    triggers: frozenset[str]
+
+
+def roles_of(f: Formula) -> Roles:
+    """What a grounded sentence must say as a condition rather than as a command, what
+    it may say as a lasting action, and what as an event.
 
     Conditions: the propositions read at the first instant, and those read at the
     instant of an antecedent or of an equivalence (``a`` in ``G(a -> b)``). States:
@@ -249,7 +267,10 @@ def conditions_of(f: Formula) -> tuple[frozenset[str], frozenset[str]]:
     action may be ("whenever the alarm is on, wait") but an achievement may not: a
     user's "whenever the light is green, put down the book" asks for
     ``G(light_green -> F(place_book))``, which the response idiom words that way, and
-    "every time put down the bottle, ..." reads badly.
+    "every time put down the bottle, ..." reads badly. Triggers: a proposition that is
+    the whole antecedent of an untimed ``G(a -> ...)`` and occurs nowhere else, which
+    "whenever you pick up the box, ..." says as an event (version 3.0 made every
+    antecedent a condition, and the fine-tune on it lost ``G(pick -> F(place))``).
     """
     conditions, states = set(atoms_read_now(f)), set()
     for n in walk(f):
@@ -258,7 +279,13 @@ def conditions_of(f: Formula) -> tuple[frozenset[str], frozenset[str]]:
         elif isinstance(n, Implies):
             conditions |= atoms_read_now(n.lhs)
             states |= atoms_read_now(n.rhs)
-    return frozenset(conditions), frozenset(states - conditions)
+    occurrences = Counter(n.name for n in walk(f) if isinstance(n, Atom))
+    triggers = {n.arg.lhs.name for n in walk(f)
+                if isinstance(n, Always) and n.interval is None
+                and isinstance(n.arg, Implies) and isinstance(n.arg.lhs, Atom)
+                and occurrences[n.arg.lhs.name] == 1}
+    return Roles(frozenset(conditions - triggers), frozenset(states - conditions),
+                 frozenset(triggers))
 
 
 def pair(rng: random.Random, s: SynthSettings, mode: str,
@@ -278,10 +305,14 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
         lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
     lifted = rename_atoms(f, lifted_names)
     lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
-    conditions, states = conditions_of(f)
+    roles = roles_of(f)
+
+    def indices(names: frozenset[str]) -> frozenset[int]:
+        return frozenset(i for i, x in enumerate(used) if x in names)
+
     props: list[Proposition] = draw_propositions(
-        rng, len(used), conditions=frozenset(i for i, x in enumerate(used) if x in conditions),
-        states=frozenset(i for i, x in enumerate(used) if x in states))
+        rng, len(used), conditions=indices(roles.conditions), states=indices(roles.states),
+        triggers=indices(roles.triggers))
     by_x = dict(zip(used, props, strict=True))
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}

@@ -2,7 +2,8 @@
 (``go_to_kitchen``) and the words a person would say for it ("head to the kitchen").
 
 Actions read as imperatives ("do not pick up the red box"); conditions as clauses
-("the door is open"). Every name is a valid proposition of the surface syntax.
+("the door is open"); an action that triggers a response reads as an event ("whenever
+you pick up the red box"). Every name is a valid proposition of the surface syntax.
 """
 
 from __future__ import annotations
@@ -47,7 +48,24 @@ OBJECT_VERBS = (
 STANDALONE_ACTIONS = (
     ("charge", ("charge", "recharge the battery")), ("wait", ("wait", "stay still")),
     ("beep", ("beep", "sound the horn")), ("report", ("report", "send a report")),
+    ("stop", ("stop", "halt", "come to a stop")),
 )
+#: Achievements said as something that happens, for the trigger of a response
+#: ("whenever you pick up the red box, ..."): ``G(pick_red_box -> F(...))``.
+EVENTS = {
+    "go_to": ("you go to the {x}", "you get to the {x}"),
+    "visit": ("you visit the {x}", "you stop by the {x}"),
+    "reach": ("you reach the {x}", "the {x} is reached", "you arrive at the {x}"),
+    "enter": ("you enter the {x}", "you go into the {x}"),
+    "leave": ("you leave the {x}", "you exit the {x}"),
+    "pick": ("you pick up the {x}", "the {x} is picked up", "you grab the {x}"),
+    "place": ("you put down the {x}", "the {x} is placed", "you drop off the {x}"),
+    "deliver": ("you deliver the {x}", "the {x} is delivered"),
+    "inspect": ("you inspect the {x}", "the {x} is inspected", "you check the {x}"),
+    "charge": ("you charge", "the battery is recharged"),
+    "beep": ("you beep", "the horn sounds"),
+    "report": ("you report", "a report is sent"),
+}
 CONDITIONS = (
     ("door_open", ("the door is open",)), ("battery_low", ("the battery is low",
                                                           "the battery runs low")),
@@ -79,19 +97,23 @@ class Proposition:
 
 
 #: Verbs of lasting actions (see :attr:`Proposition.lasting`).
-LASTING_VERBS = frozenset({"at", "hold", "wait"})
+LASTING_VERBS = frozenset({"at", "hold", "wait", "stop"})
 
 
 def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = frozenset(),
-                      states: frozenset[int] = frozenset()) -> list[Proposition]:
+                      states: frozenset[int] = frozenset(),
+                      triggers: frozenset[int] = frozenset()) -> list[Proposition]:
     """``k`` propositions with distinct names, mixing actions and conditions; the ones
     at the indices in ``conditions`` are conditions, those in ``states`` a condition or
-    a lasting action, half and half."""
+    a lasting action, those in ``triggers`` a condition or an achievement said as an
+    event, half and half."""
     found: dict[str, Proposition] = {}
     while len(found) < k:
         i = len(found)
         if i in conditions:
             prop = _draw_condition(rng)
+        elif i in triggers:
+            prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_event(rng)
         elif i in states:
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_lasting(rng)
         else:
@@ -106,11 +128,27 @@ def _draw_lasting(rng: random.Random) -> Proposition:
         phrases = dict(PLACE_VERBS)["at"]
         name, words = _thing(rng, PLACES, NUMBERED_PLACES)
         return _about("at", phrases, name, words, action=True)
-    if kind < 0.9:
+    if kind < 0.85:
         phrases = dict(OBJECT_VERBS)["hold"]
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
         return _about("hold", phrases, name, words, action=True)
-    return Proposition("wait", dict(STANDALONE_ACTIONS)["wait"], action=True, lasting=True)
+    verb = "wait" if kind < 0.93 else "stop"
+    return Proposition(verb, dict(STANDALONE_ACTIONS)[verb], action=True, lasting=True)
+
+
+def _draw_event(rng: random.Random) -> Proposition:
+    """An achievement said as an event: a clause, so ``action`` is false."""
+    kind = rng.random()
+    if kind < 0.45:
+        verb = rng.choice([v for v, _ in PLACE_VERBS if v in EVENTS])
+        name, words = _thing(rng, PLACES, NUMBERED_PLACES)
+    elif kind < 0.9:
+        verb = rng.choice([v for v, _ in OBJECT_VERBS if v in EVENTS])
+        name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    else:
+        verb = rng.choice([v for v, _ in STANDALONE_ACTIONS if v in EVENTS])
+        return Proposition(verb, EVENTS[verb], action=False)
+    return _about(verb, EVENTS[verb], name, words, action=False)
 
 
 def _draw_condition(rng: random.Random) -> Proposition:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import random
+import re
 from collections import Counter
 
 import pytest
@@ -11,6 +12,7 @@ from ara.data.synthetic import (
     PATTERN_MAX_DEPTH,
     SynthSettings,
     is_held_out,
+    roles_of,
     sample_formula,
     shape,
     synthetic_records,
@@ -19,6 +21,8 @@ from ara.errors import ConfigError
 from ara.grammars import Syntax, parse
 from ara.grammars.ast import (
     Always,
+    And,
+    Atom,
     Eventually,
     Iff,
     Implies,
@@ -60,11 +64,20 @@ def test_records_fit_the_decoding_grammar(train_records):
         assert Syntax(aps=r.aps, intervals=True, max_depth=5, max_args=2).accepts(r.stl)
 
 
+def is_three_steps(f) -> bool:
+    """``F(a & F(b & F(c)))`` with any steps a, b, c."""
+    def step_then(g):
+        return isinstance(g, Eventually) and isinstance(g.arg, And) \
+            and len(g.arg.args) == 2 and g.interval is None
+
+    return step_then(f) and step_then(f.arg.args[1]) \
+        and isinstance(f.arg.args[1].arg.args[1], Eventually)
+
+
 def test_three_step_sequences_and_visits_in_any_order_are_drawn(train_records):
     """Tests that the patterns users write most are there, each in a few wordings:
     F(a & F(b & F(c))) is depth 5, which a depth limit of 4 once rejected silently."""
-    three_steps = [r for r in train_records
-                   if shape(r.formula) == shape(parse("F(x & F(y & F(z)))"))]
+    three_steps = [r for r in train_records if is_three_steps(r.formula)]
     assert len(three_steps) >= 10
     assert len({r.nl.split(" ")[0] for r in three_steps}) > 3
     assert any("in any order" in r.nl for r in train_records)
@@ -109,13 +122,43 @@ def test_grounded_rows_say_a_triggered_proposition_as_a_condition(train_records)
     lhs = [name for n in implications for name in atoms_read_now(n.lhs)]
     rhs = [name for n in implications for name in atoms_read_now(n.rhs)]
     assert len(lhs) > 50 and len(rhs) > 50
-    assert not [name for name in lhs if name.startswith(ACTION_PREFIXES)]
+    # An action triggers only as the whole antecedent of an untimed G(a -> ...),
+    # where it is said as an event; see the next test
+    triggers = {n.arg.lhs.name for r in grounded for n in walk(r.formula)
+                if isinstance(n, Always) and n.interval is None
+                and isinstance(n.arg, Implies) and isinstance(n.arg.lhs, Atom)}
+    assert not [name for name in lhs if name.startswith(ACTION_PREFIXES)
+                and name not in triggers]
     achievements = tuple(p for p in ACTION_PREFIXES if p not in LASTING_PREFIXES)
     assert not [name for name in rhs if name.startswith(achievements)]
     assert [name for name in rhs if name.startswith(LASTING_PREFIXES)]
     # The response to a command is said the way users say it
     assert any(r.nl.lower().startswith(("whenever", "every time")) and "eventually"
                not in r.nl and isinstance(r.formula, Always) for r in grounded)
+
+
+def test_an_action_may_trigger_a_response_said_as_an_event(train_records):
+    """Tests that "whenever you pick up the red box, put it on the shelf" is taught as
+    G(pick_red_box -> F(...)): without such rows a fine-tune lost that reading of the
+    help request, writing F(pick -> F(place))."""
+    responses = [r for r in train_records if r.form == "grounded"
+                 and isinstance(r.formula, Always) and isinstance(r.formula.arg, Implies)
+                 and isinstance(r.formula.arg.lhs, Atom)
+                 and r.formula.arg.lhs.name.startswith(ACTION_PREFIXES)]
+    assert len(responses) >= 5
+    for r in responses:
+        thing = r.formula.arg.lhs.name.split("_", 1)[-1].replace("_", " ")
+        assert f"you {thing}" not in r.nl  # never the bare imperative after "you"
+        assert re.search(r"\b(you|is|are) ", r.nl), r.nl
+
+
+def test_roles_of_a_response_with_an_action_trigger():
+    """Tests the roles the grounded wording gives each proposition."""
+    roles = roles_of(parse("G(a -> F(b)) & (c -> F(d)) & G(e & f -> g)"))
+    assert roles.triggers == {"a"}
+    assert roles.conditions == {"c", "e", "f"} and roles.states == {"g"}
+    # A proposition said elsewhere too keeps one wording: a condition there
+    assert roles_of(parse("G(a -> F(b)) & F(a)")).triggers == frozenset()
 
 
 def test_held_out_shapes_stay_on_the_test_side(train_records):
