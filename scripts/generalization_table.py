@@ -44,6 +44,10 @@ MODELS = {
                                       ("compositional", "2cc898a81b54")),
     "compositional-adapter-v6-270m": ("compositional adapter v6 (not shipped)",
                                       ("compositional", "820c2d11c0c8")),
+    "compositional-adapter-v7-270m": ("compositional adapter v7 (not shipped)",
+                                      ("compositional", "6c3132045205")),
+    "compositional-adapter-v8-270m": ("compositional adapter v8 (not shipped)",
+                                      ("compositional", "6c3132045205")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),
