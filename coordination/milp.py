@@ -12,7 +12,11 @@ callers turn anything but ``optimal`` into "cannot help".
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -112,6 +116,24 @@ class MILPSolver(Protocol):
     def solve(self, model: LinearModel, time_limit_s: float = 10.0) -> Solution: ...
 
 
+@contextlib.contextmanager
+def _stdout_silenced() -> Iterator[None]:
+    """Send file descriptor 1 to the null device for the block.
+
+    HiGHS 1.16 prints its banner from C++ while ``Highs()`` is constructed, before
+    ``output_flag`` can be set, and ``ara coord plan --json`` must keep stdout pure JSON.
+    """
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 class HiGHSSolver:
     """HiGHS through ``highspy``, one thread, quiet."""
 
@@ -124,8 +146,9 @@ class HiGHSSolver:
         import highspy
         import numpy as np
 
-        h = highspy.Highs()
-        h.setOptionValue("output_flag", False)
+        with _stdout_silenced():
+            h = highspy.Highs()
+            h.setOptionValue("output_flag", False)
         h.setOptionValue("threads", self.threads)
         h.setOptionValue("time_limit", float(time_limit_s))
         h.setOptionValue("mip_rel_gap", 0.0)

@@ -102,6 +102,16 @@ def test_formulas_outside_the_event_fragment_are_refused_by_name():
         plan_spec(PAPER, (0, 0), {"t": parse("F a")}, vocab, objective="fastest")
 
 
+def test_a_highs_solve_writes_nothing_to_stdout(capfd):
+    """`ara coord plan --json` prints the plan on stdout; HiGHS 1.16 prints a banner from C++
+    when it is constructed, which would break every JSON reader."""
+    m = LinearModel()
+    m.binary("x")
+    m.ge({"x": 1}, 1)
+    assert HiGHSSolver().solve(m).status == "optimal"
+    assert capfd.readouterr().out == ""
+
+
 def test_solver_reports_infeasible_models_and_unknown_solvers():
     m = LinearModel()
     m.binary("x")
