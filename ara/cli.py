@@ -12,7 +12,7 @@ from ara.data.cli import data_app
 from ara.demo import demo_cmd
 from ara.eval.cli import eval_app, translate_cmd
 from ara.grammars.cli import grammar_cmd, stl_app
-from ara.training.cli import export_cmd, model_app, train_cmd
+from ara.training.cli import export_cmd, model_app, soup_cmd, train_cmd
 
 app = typer.Typer(
     help="ask-reason-assist: natural language to Signal Temporal Logic with guaranteed "
@@ -30,6 +30,7 @@ app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)
 app.command("train")(train_cmd)
 app.command("export")(export_cmd)
+app.command("soup")(soup_cmd)
 
 
 def _note(message, category, filename, lineno, file=None, line=None) -> str:

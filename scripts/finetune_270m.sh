@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
-# The shipped fine-tune, end to end, on a CPU: two training runs of about 85 and 60 min on
-# 2 cores on the compositional mixture (each fits one session), then export, ship and
-# the evaluations (about 45 min).
+# The shipped fine-tune, end to end, on a CPU: five training runs of 40 to 85 min on 2
+# cores on the compositional mixtures (each fits one session), the average of the last
+# two (a "soup"), then export, ship and the evaluations (about 45 min).
 #
-#   scripts/finetune_270m.sh [STEP ...]   steps: train continue export ship eval paper
-#                                         disjoint full
-#                                         (default: train continue export ship eval)
+#   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 soup export ship
+#                                         eval paper disjoint full
+#                                         (default: all of them from train to eval)
 #
 # train: v3 (training/configs/gemma3_270m_lora_cpu_compositional.yaml); continue: v4,
-#   400 more steps from v3's adapter (..._compositional_v4.yaml); export/ship: v4 becomes
-#   `--model finetuned`.
+#   400 more steps from v3's adapter (..._compositional_v4.yaml); v6, v7, v8: three more
+#   runs from v4's adapter (v6 on mixture 820c2d11c0c8; v7 300 steps and v8, from v6's
+#   adapter, 150 steps, both on 6c3132045205); soup: the mean of v7's and v8's adapters
+#   (`ara soup`); export/ship: the soup becomes `--model finetuned`.
 # eval: the generalization runs of the new adapter, the paper-split adapter and the base
 #   model (scripts/eval_generalization.sh), the round trip, the help-request wordings.
 # paper: retrains the paper-split adapter (`--model finetuned-paper`, Table I) from its
@@ -17,15 +19,18 @@
 #   full: the shipped adapter zero-shot under the grammar on the whole paper test side.
 #
 # Each step can be rerun alone; training resumes from its newest checkpoint and the
-# evaluations from their finished samples.
+# evaluations from their finished samples. The v5 to v8 configs start from the adapters
+# committed under docs/results/training/ (v4 and v6), so v6 to v8 can run without the
+# earlier runs' folders.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=.venv/bin
 first_run=runs/train/gemma3-270m-lora-compositional
-run=runs/train/gemma3-270m-lora-compositional-v4
+v4_run=runs/train/gemma3-270m-lora-compositional-v4
+run=runs/train/gemma3-270m-lora-compositional-soup
 paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
-steps=${*:-train continue export ship eval}
+steps=${*:-train continue v6 v7 v8 soup export ship eval}
 
 train() {  # CONFIG RUN_FOLDER
   if [ -f "$2/run.json" ]; then resume=--resume; else resume=; fi
@@ -52,7 +57,9 @@ adapter = SHIPPED / name
 manifest = {"file": name, "sha256": sha256_file(adapter),
             "run": json.loads((run / "run.json").read_text()),
             "export": json.loads((run / "export" / "export.json").read_text()),
-            "heldout": json.loads((run / "heldout.json").read_text())}
+            # A soup was never trained as a whole: no held-out check of its own
+            "heldout": (json.loads((run / "heldout.json").read_text())
+                        if (run / "heldout.json").is_file() else None)}
 # What a user runs: the adapter on the embedded Q4_K_M base, against the merged HF model
 data = load_or_prepare(split, 0)
 records = data.records("test", "lifted")[:20] + data.records("test", "grounded")[:20]
@@ -70,7 +77,13 @@ for step in $steps; do
   train)
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
-    train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$run" ;;
+    train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
+  v6|v7|v8)
+    train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
+      "runs/train/gemma3-270m-lora-compositional-$step" ;;
+  soup)
+    $bin/ara soup --run runs/train/gemma3-270m-lora-compositional-v7 \
+      --run runs/train/gemma3-270m-lora-compositional-v8 --out "$run" ;;
   export)
     # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
     $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
@@ -100,7 +113,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue export ship eval paper disjoint full)" >&2
+  *) echo "unknown step $step (train continue v6 v7 v8 soup export ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac
 done

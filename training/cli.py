@@ -42,6 +42,40 @@ def train_cmd(
     typer.echo(json.dumps(summary, indent=2))
 
 
+def soup_cmd(
+    runs: list[Path] = typer.Option(..., "--run",
+                                    help="A finished `ara train` run folder (twice or more)."),
+    weights: list[float] = typer.Option(None, "--weight",
+                                        help="One weight per --run, in order [default: equal]."),
+    out: Path = typer.Option(..., "--out", help="The soup's run folder (adapter/, run.json)."),
+) -> None:
+    """Average the adapters of runs that grew from one start into one exact LoRA adapter.
+
+    The result is a run folder like any other: `ara export --run OUT --lora-gguf` turns it
+    into a GGUF LoRA for `ara translate --model lora:OUT/export/lora.gguf`.
+    """
+    import json
+
+    from ara.errors import ConfigError
+    from ara.training.soup import SoupPart, average_adapters
+
+    with user_errors():
+        weights = weights or [1.0] * len(runs)
+        if len(weights) != len(runs):
+            raise ConfigError(f"{len(weights)} --weight values for {len(runs)} --run folders")
+        for run in runs:
+            if not (run / "run.json").is_file():
+                raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")
+        parts = [SoupPart(run / "adapter", w) for run, w in zip(runs, weights, strict=True)]
+        average_adapters(parts, out / "adapter")
+        # The first run's record (base model, data version) is what export needs; the
+        # soup's own parts say where the weights came from.
+        record = json.loads((runs[0] / "run.json").read_text())
+        record["soup"] = json.loads((out / "adapter" / "soup.json").read_text())
+        (out / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    typer.echo(json.dumps(record["soup"], indent=2))
+
+
 def export_cmd(
     run: Path = typer.Option(..., "--run", help="A finished `ara train` run folder."),
     quant: str = typer.Option("f16,q8_0,q4_k_m", "--quant",

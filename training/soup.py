@@ -1,0 +1,109 @@
+"""A weighted average of LoRA adapters, written as one exact LoRA adapter.
+
+Adapters trained from the same start (here: every compositional run grows from v3's
+adapter) can be averaged in weight space, a "model soup" (Wortsman et al., 2022): runs
+that each learned a little of something different often keep both in the average.
+
+LoRA factors cannot be averaged directly (``mean(B) @ mean(A)`` is not
+``mean(B @ A)``), but the average of the updates is itself a LoRA of the summed rank:
+stack the ``A`` factors and place each weighted ``B`` beside the others,
+
+    sum_i w_i s_i B_i A_i  =  s [w_1 s_1/s B_1 | ... | w_n s_n/s B_n] [A_1; ...; A_n],
+
+with ``s_i = alpha_i / r_i`` each adapter's scaling and ``s`` the result's. The result is
+exact, loads in PEFT and converts to a GGUF LoRA like any adapter (a rank-16 pair
+becomes rank 32, about twice the file).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from ara.errors import ConfigError
+
+CONFIG = "adapter_config.json"
+WEIGHTS = "adapter_model.safetensors"
+
+
+@dataclass(frozen=True)
+class SoupPart:
+    """One adapter folder (PEFT layout) and its weight in the average."""
+
+    adapter: Path
+    weight: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.weight) or self.weight <= 0:
+            raise ConfigError(f"a soup weight must be a positive number, got {self.weight}")
+
+
+def _load(adapter: Path) -> tuple[dict, dict]:
+    from safetensors.torch import load_file
+
+    config_file, weights_file = adapter / CONFIG, adapter / WEIGHTS
+    if not config_file.is_file() or not weights_file.is_file():
+        raise ConfigError(f"{adapter} is not a PEFT LoRA adapter folder "
+                          f"(needs {CONFIG} and {WEIGHTS})")
+    config = json.loads(config_file.read_text())
+    if config.get("peft_type") != "LORA" or config.get("rank_pattern") or config.get("alpha_pattern"):
+        raise ConfigError(f"{adapter}: only plain LoRA adapters (one rank, one alpha) average")
+    return config, load_file(str(weights_file))
+
+
+def _setting(config: dict, key: str):
+    """A config value, lists compared as sets (PEFT writes target_modules in any order)."""
+    value = config.get(key)
+    return frozenset(value) if isinstance(value, list) else value
+
+
+def average_adapters(parts: list[SoupPart], out: Path) -> Path:
+    """Write the weighted mean of ``parts`` (weights normalized to sum 1) to ``out``."""
+    import torch
+    from safetensors.torch import save_file
+
+    if len(parts) < 2:
+        raise ConfigError("a soup needs at least two adapters")
+    loaded = [_load(p.adapter) for p in parts]
+    first_config, first_weights = loaded[0]
+    for part, (config, weights) in zip(parts[1:], loaded[1:], strict=True):
+        if set(weights) != set(first_weights) or any(
+                _setting(config, k) != _setting(first_config, k)
+                for k in ("base_model_name_or_path", "target_modules", "use_rslora", "use_dora")):
+            raise ConfigError(f"{part.adapter} does not adapt the same modules of the same "
+                              f"base as {parts[0].adapter}: they cannot be averaged")
+    if first_config.get("use_dora"):
+        raise ConfigError("DoRA adapters do not average as LoRA updates")
+    total = sum(p.weight for p in parts)
+    ranks = [c["r"] for c, _ in loaded]
+    scalings = [c["lora_alpha"] / (math.sqrt(c["r"]) if c.get("use_rslora") else c["r"])
+                for c, _ in loaded]
+    rank = sum(ranks)
+    # Keep the first adapter's scaling; each B factor carries its own ratio to it.
+    scaling = scalings[0]
+    alpha = scaling * (math.sqrt(rank) if first_config.get("use_rslora") else rank)
+    merged: dict[str, torch.Tensor] = {}
+    for key, tensor in first_weights.items():
+        if ".lora_A." in key:
+            merged[key] = torch.cat([w[key] for _, w in loaded], dim=0).contiguous()
+        elif ".lora_B." in key:
+            merged[key] = torch.cat([
+                w[key] * (part.weight / total) * (s / scaling)
+                for part, (_, w), s in zip(parts, loaded, scalings, strict=True)
+            ], dim=1).to(tensor.dtype).contiguous()
+        else:
+            raise ConfigError(f"{parts[0].adapter}: tensor {key} is not a LoRA factor")
+    out.mkdir(parents=True, exist_ok=True)
+    save_file(merged, str(out / WEIGHTS))
+    config = dict(first_config, r=rank, lora_alpha=alpha)
+    (out / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
+    for extra in ("tokenizer.json", "tokenizer_config.json"):
+        if (parts[0].adapter / extra).is_file():
+            shutil.copy2(parts[0].adapter / extra, out / extra)
+    (out / "soup.json").write_text(json.dumps({
+        "parts": [{"adapter": str(p.adapter), "weight": p.weight / total} for p in parts],
+        "rank": rank, "lora_alpha": alpha}, indent=2) + "\n")
+    return out
