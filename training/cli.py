@@ -46,13 +46,13 @@ def soup_cmd(
     runs: list[Path] = typer.Option(..., "--run",
                                     help="A finished `ara train` run folder (twice or more)."),
     weights: list[float] = typer.Option(None, "--weight",
-                                        help="One weight per --run, in order [default: equal]."),
+                                        help="One weight per --run, in order (default: all equal)."),
     out: Path = typer.Option(..., "--out", help="The soup's run folder (adapter/, run.json)."),
 ) -> None:
     """Average the adapters of runs that grew from one start into one exact LoRA adapter.
 
-    The result is a run folder like any other: `ara export --run OUT --lora-gguf` turns it
-    into a GGUF LoRA for `ara translate --model lora:OUT/export/lora.gguf`.
+    The result is a run folder like any other: `ara export --run OUT --lora-gguf` turns
+    it into a GGUF LoRA for `ara translate --model lora:OUT/export/lora.gguf`.
     """
     import json
 
