@@ -45,8 +45,8 @@ def train_cmd(
 def soup_cmd(
     runs: list[Path] = typer.Option(..., "--run",
                                     help="A finished `ara train` run folder (twice or more)."),
-    weights: list[float] = typer.Option(None, "--weight",
-                                        help="One weight per --run, in order (default: all equal)."),
+    weights: list[float] = typer.Option(
+        None, "--weight", help="One weight per --run, in order (default: all equal)."),
     out: Path = typer.Option(..., "--out", help="The soup's run folder (adapter/, run.json)."),
 ) -> None:
     """Average the adapters of runs that grew from one start into one exact LoRA adapter.
@@ -67,11 +67,11 @@ def soup_cmd(
             if not (run / "run.json").is_file():
                 raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")
         parts = [SoupPart(run / "adapter", w) for run, w in zip(runs, weights, strict=True)]
-        average_adapters(parts, out / "adapter")
+        soup = average_adapters(parts, out / "adapter")
         # The first run's record (base model, data version) is what export needs; the
         # soup's own parts say where the weights came from.
         record = json.loads((runs[0] / "run.json").read_text())
-        record["soup"] = json.loads((out / "adapter" / "soup.json").read_text())
+        record["soup"] = soup
         (out / "run.json").write_text(json.dumps(record, indent=2) + "\n")
     typer.echo(json.dumps(record["soup"], indent=2))
 

@@ -49,8 +49,11 @@ def _load(adapter: Path) -> tuple[dict, dict]:
         raise ConfigError(f"{adapter} is not a PEFT LoRA adapter folder "
                           f"(needs {CONFIG} and {WEIGHTS})")
     config = json.loads(config_file.read_text())
-    if config.get("peft_type") != "LORA" or config.get("rank_pattern") or config.get("alpha_pattern"):
+    if (config.get("peft_type") != "LORA" or config.get("rank_pattern")
+            or config.get("alpha_pattern")):
         raise ConfigError(f"{adapter}: only plain LoRA adapters (one rank, one alpha) average")
+    if config.get("use_dora"):
+        raise ConfigError(f"{adapter}: DoRA adapters do not average as LoRA updates")
     return config, load_file(str(weights_file))
 
 
@@ -60,8 +63,11 @@ def _setting(config: dict, key: str):
     return frozenset(value) if isinstance(value, list) else value
 
 
-def average_adapters(parts: list[SoupPart], out: Path) -> Path:
-    """Write the weighted mean of ``parts`` (weights normalized to sum 1) to ``out``."""
+def average_adapters(parts: list[SoupPart], out: Path) -> dict:
+    """Write the weighted mean of ``parts`` (weights normalized to sum 1) to ``out``.
+
+    Returns the soup's record (its parts, rank and alpha), also written to ``soup.json``.
+    """
     import torch
     from safetensors.torch import save_file
 
@@ -75,13 +81,10 @@ def average_adapters(parts: list[SoupPart], out: Path) -> Path:
                 for k in ("base_model_name_or_path", "target_modules", "use_rslora", "use_dora")):
             raise ConfigError(f"{part.adapter} does not adapt the same modules of the same "
                               f"base as {parts[0].adapter}: they cannot be averaged")
-    if first_config.get("use_dora"):
-        raise ConfigError("DoRA adapters do not average as LoRA updates")
     total = sum(p.weight for p in parts)
-    ranks = [c["r"] for c, _ in loaded]
     scalings = [c["lora_alpha"] / (math.sqrt(c["r"]) if c.get("use_rslora") else c["r"])
                 for c, _ in loaded]
-    rank = sum(ranks)
+    rank = sum(c["r"] for c, _ in loaded)
     # Keep the first adapter's scaling; each B factor carries its own ratio to it.
     scaling = scalings[0]
     alpha = scaling * (math.sqrt(rank) if first_config.get("use_rslora") else rank)
@@ -103,7 +106,7 @@ def average_adapters(parts: list[SoupPart], out: Path) -> Path:
     for extra in ("tokenizer.json", "tokenizer_config.json"):
         if (parts[0].adapter / extra).is_file():
             shutil.copy2(parts[0].adapter / extra, out / extra)
-    (out / "soup.json").write_text(json.dumps({
-        "parts": [{"adapter": str(p.adapter), "weight": p.weight / total} for p in parts],
-        "rank": rank, "lora_alpha": alpha}, indent=2) + "\n")
-    return out
+    record = {"parts": [{"adapter": str(p.adapter), "weight": p.weight / total} for p in parts],
+              "rank": rank, "lora_alpha": alpha}
+    (out / "soup.json").write_text(json.dumps(record, indent=2) + "\n")
+    return record

@@ -45,7 +45,8 @@ def test_the_soup_adds_the_updates_of_its_parts_in_proportion(tmp_path):
     config_b = json.loads((b / "adapter_config.json").read_text())
     config_b["target_modules"] = sorted(config_b["target_modules"], reverse=True)
     (b / "adapter_config.json").write_text(json.dumps(config_b))
-    soup = average_adapters([SoupPart(a, 3.0), SoupPart(b, 1.0)], tmp_path / "soup")
+    soup = tmp_path / "soup"
+    record = average_adapters([SoupPart(a, 3.0), SoupPart(b, 1.0)], soup)
 
     da, db, ds = updates(a), updates(b), updates(soup)
     assert set(ds) == set(da) == set(db) and len(ds) == 14   # 7 linear modules x 2 layers
@@ -55,6 +56,7 @@ def test_the_soup_adds_the_updates_of_its_parts_in_proportion(tmp_path):
     config = json.loads((soup / "adapter_config.json").read_text())
     assert config["r"] == 6 and config["lora_alpha"] / config["r"] == 2.0
     assert json.loads((soup / "soup.json").read_text())["parts"][0]["weight"] == 0.75
+    assert record == json.loads((soup / "soup.json").read_text())
 
 
 def test_adapters_that_cannot_be_averaged_are_refused_by_name(tmp_path):
