@@ -35,7 +35,9 @@ def demo_cmd(
     from ara.grammars.spot_bridge import equivalent, implies
 
     typer.echo("== data: versioned splits")
-    for split in ("paper", "disjoint", "timed", "compositional", "handwritten"):
+    from ara.data.store import SPLITS
+
+    for split in SPLITS:
         p = prepare(split, 0)
         counts = ", ".join(f"{k} {sum(v.values())}" for k, v in p.manifest["counts"].items())
         typer.echo(f"  {p.folder.name}: {counts} records, "

@@ -22,7 +22,7 @@ which makes it agree with navi on every sentence they share.
 
 Test: synthetic rows whose shapes are held out, worded with held-out phrasings where
 a construct has them. Records of any source with a held-out shape stay out of train,
-and so do records whose sentence is one of the hand-written suite's (the generator
+and so do records whose sentence is one of the hand-written suites' (the generator
 says short ones such as "at no time ( prop_1 )" on its own).
 """
 
@@ -32,7 +32,7 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
-from ara.data.handwritten import suite_records
+from ara.data.handwritten import SUITES, suite_records
 from ara.data.help_requests import HELP_REQUEST_ROWS, help_request_records
 from ara.data.normalize import (
     TIMED_LABELS_VERSION,
@@ -92,7 +92,7 @@ def compositional_split(raw_dir: Path, seed: int
     train = (nl2tl + synthetic_records(SYNTHETIC_TRAIN_ROWS, seed, held_out=False,
                                        settings=settings)
              + help_request_records(HELP_REQUEST_ROWS, seed))
-    suite = {sentence_key(r.nl) for r in suite_records()}
+    suite = {sentence_key(r.nl) for split in SUITES for r in suite_records(split)}
     train = [r for r in train if sentence_key(r.nl) not in suite]
     test = synthetic_records(SYNTHETIC_TEST_ROWS, seed, held_out=True, settings=settings)
     sources = {name: sha256_file(raw_dir / name)

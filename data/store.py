@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ara.data import manifest as mf
-from ara.data.handwritten import SUITE, suite_records
+from ara.data.handwritten import SUITES, suite_records
 from ara.data.mixture import compositional_split
 from ara.data.normalize import (
     NORMALIZER_VERSION,
@@ -35,10 +35,10 @@ from ara.provenance import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
-SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten")
+SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten", "handwritten2")
 FORMS = ("lifted", "grounded")
 #: Splits fixed by their files, whatever the seed.
-UNSEEDED = ("timed", "handwritten")
+UNSEEDED = ("timed", "handwritten", "handwritten2")
 
 
 class DataVersionWarning(UserWarning):
@@ -88,10 +88,10 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
         raise ConfigError(f"unknown split {split!r}. {did_you_mean(split, SPLITS)}")
     if split == "compositional":
         return compositional_split(RAW_DIR, seed)
-    if split == "handwritten":
+    if split in SUITES:
         # Test only: few-shot examples for it come from the compositional train side.
-        return ({"train": [], "test": suite_records()}, [],
-                {SUITE.name: sha256_file(SUITE)})
+        return ({"train": [], "test": suite_records(split)}, [],
+                {SUITES[split].name: sha256_file(SUITES[split])})
     if split == "timed":
         files = ["lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"]
         train, rej_train = normalize_timed(read_jsonl(RAW_DIR / files[0]), "nl2tl_timed_train")
@@ -116,8 +116,8 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
         split: ``paper`` (random 4,500/3,000 rows of navi), ``disjoint`` (no lifted
             formula on both sides), ``timed`` (NL2TL's own train/dev, seed unused) or
             ``compositional`` (the training mixture; test: held-out synthetic shapes
-            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten`` (the
-            hand-written suite, test only; seed unused).
+            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten`` and
+            ``handwritten2`` (the hand-written suites, test only; seed unused).
         seed: Shuffle seed.
         root: Parent folder; :func:`default_root` by default.
     """

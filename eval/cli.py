@@ -99,7 +99,8 @@ def ablation_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder: samples.jsonl, results.json, ..."),
     split: str = typer.Option("paper", "--split",
                               help="paper, disjoint, timed, compositional (held-out shapes "
-                                   "and phrasings) or handwritten (the hand-written suite)."),
+                                   "and phrasings), handwritten (the hand-written suite) "
+                                   "or handwritten2 (the second, never read for data)."),
     form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
     variants: str = typer.Option("F,F+P,F+P+C", "--variants",
                                  help="Comma list of variants: letters F, P, C joined by "

@@ -63,7 +63,7 @@ class AblationConfig:
 
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
-            ``handwritten``).
+            ``handwritten``, ``handwritten2``).
         form: ``lifted`` or ``grounded`` records.
         variants: Variant names, e.g. ``("F", "F+P", "F+P+C")``.
         shots: Few-shot counts for the F variants, 0 to 50 (0: F runs zero-shot;
@@ -152,8 +152,8 @@ def test_sample(config: AblationConfig, split: PreparedSplit) -> list[Record]:
 
 def shot_pool(config: AblationConfig, split: PreparedSplit) -> list[Record]:
     """Where worked examples come from: the split's own train side, or for a test-only
-    split (``handwritten``) the compositional train side, which holds none of its
-    sentences."""
+    split (the hand-written suites) the compositional train side, which holds none of
+    their sentences."""
     pool = split.records("train", config.form)
     if pool or not any(v.few_shot for v in map(Variant.parse, config.variants)):
         return pool

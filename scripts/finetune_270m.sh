@@ -3,7 +3,7 @@
 # cores on the compositional mixtures (each fits one session), the average of the last
 # two (a "soup"), then export, ship and the evaluations (about 45 min).
 #
-#   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 soup export ship
+#   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 soup export ship
 #                                         eval paper disjoint full
 #                                         (default: all of them from train to eval)
 #
@@ -11,7 +11,8 @@
 #   400 more steps from v3's adapter (..._compositional_v4.yaml); v6, v7, v8: three more
 #   runs from v4's adapter (v6 on mixture 820c2d11c0c8; v7 300 steps and v8, from v6's
 #   adapter, 150 steps, both on 6c3132045205); soup: the mean of v7's and v8's adapters
-#   (`ara soup`); export/ship: the soup becomes `--model finetuned`.
+#   (`ara soup`); export/ship: the soup becomes `--model finetuned`. v9 (not in the
+#   default steps): v7's config with another seed, the seed study of docs/generalization.md.
 # eval: the generalization runs of the new adapter, the paper-split adapter and the base
 #   model (scripts/eval_generalization.sh), the round trip, the help-request wordings.
 # paper: retrains the paper-split adapter (`--model finetuned-paper`, Table I) from its
@@ -78,7 +79,7 @@ for step in $steps; do
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
     train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
-  v6|v7|v8)
+  v6|v7|v8|v9)
     train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
       "runs/train/gemma3-270m-lora-compositional-$step" ;;
   soup)
@@ -92,9 +93,9 @@ for step in $steps; do
   eval)
     scripts/eval_generalization.sh finetuned compositional-adapter-270m
     VARIANTS=C,F+C scripts/eval_generalization.sh finetuned-paper paper-adapter-270m \
-      handwritten compositional timed
+      handwritten handwritten2 compositional timed
     VARIANTS=C,F+C scripts/eval_generalization.sh default base-270m \
-      handwritten compositional timed
+      handwritten handwritten2 compositional timed
     $bin/python scripts/generalization_table.py
     $bin/python scripts/round_trip.py
     $bin/python bench/help_request_wordings.py ;;
@@ -113,7 +114,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 soup export ship eval paper disjoint full)" >&2
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 soup export ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac
 done

@@ -48,10 +48,15 @@ MODELS = {
                                       ("compositional", "6c3132045205")),
     "compositional-adapter-v8-270m": ("compositional adapter v8 (not shipped)",
                                       ("compositional", "6c3132045205")),
+    "compositional-adapter-v9-270m": ("compositional adapter v9 (v7, seed 6; not shipped)",
+                                      ("compositional", "6c3132045205")),
     "soup-v4v7v8-270m": ("soup v4+v7+v8 (not shipped)", ("compositional", "6c3132045205")),
+    "soup-v7v8v9-270m": ("soup v7+v8+v9 (not shipped)", ("compositional", "6c3132045205")),
+    "soup-v7v9-270m": ("soup v7+v9 (not shipped)", ("compositional", "6c3132045205")),
     "compositional-adapter-270m": ("soup v7+v8 (shipped)", ("compositional", "6c3132045205")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
+        ("handwritten2", "lifted"), ("handwritten2", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),
         ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
 VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]

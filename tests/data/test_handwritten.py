@@ -1,4 +1,4 @@
-"""The hand-written suite: large enough, well-formed, unambiguous, never trained on."""
+"""The hand-written suites: large enough, well-formed, unambiguous, never trained on."""
 
 from __future__ import annotations
 
@@ -7,54 +7,69 @@ import re
 
 import pytest
 
-from ara.data.handwritten import load_suite, suite_records
+from ara.data.handwritten import SUITE, SUITE2, SUITES, load_suite, suite_records
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
 from ara.grammars.spot_bridge import equivalent
 
+#: The least each suite holds: entries, and entries with a time bound.
+SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40)}
 
-@pytest.fixture(scope="module")
-def suite():
-    return load_suite()
+
+@pytest.fixture(scope="module", params=sorted(SUITES))
+def suite(request):
+    return request.param, load_suite(SUITES[request.param])
 
 
 def test_suite_covers_what_the_issue_asks(suite):
-    """Tests that the suite has >= 150 instructions, >= 40 timed, in both forms."""
-    assert len(suite) >= 150
-    assert sum("[" in e.stl for e in suite) >= 40
-    forms = {e.form for e in suite}
-    assert forms == {"lifted", "grounded"}
-    assert {e.domain for e in suite} == {"lifted", "navigation", "manipulation", "warehouse"}
+    """Tests that each suite is large enough, with time bounds, in both forms and every
+    domain."""
+    name, entries = suite
+    least, least_timed = SIZES[name]
+    assert len(entries) >= least
+    assert sum("[" in e.stl for e in entries) >= least_timed
+    assert {e.form for e in entries} == {"lifted", "grounded"}
+    assert {e.domain for e in entries} == {"lifted", "navigation", "manipulation", "warehouse"}
 
 
 def test_every_reference_differs_from_the_readings_it_must_not_be_confused_with(suite):
     """Tests, with Spot, that no listed confusion is equivalent to its reference (so a
     translator that gives one is counted wrong)."""
-    undistinguished = [(e.nl, c) for e in suite for c in e.confusions
+    _, entries = suite
+    undistinguished = [(e.nl, c) for e in entries for c in e.confusions
                        if equivalent(parse(e.stl), parse(c), timeout_s=30)]
     assert undistinguished == []
 
 
-def test_no_suite_sentence_occurs_in_any_training_source(suite):
-    """Tests that the suite is not copied from NL2TL: no sentence (case and spacing
-    ignored) occurs in any vendored raw file."""
-    def norm(text: str) -> str:
-        return re.sub(r"[^a-z0-9_]+", " ", text.lower()).strip()
+def _norm(text: str) -> str:
+    return re.sub(r"[^a-z0-9_]+", " ", text.lower()).strip()
 
+
+def test_no_suite_sentence_occurs_in_any_training_source(suite):
+    """Tests that no suite is copied from NL2TL: no sentence (case and spacing ignored)
+    occurs in any vendored raw file."""
+    _, entries = suite
     seen = set()
     for path in RAW_DIR.glob("*.jsonl"):
         for line in path.read_text().splitlines():
             row = json.loads(line)
             for field in ("sentence", "logic_sentence"):
                 if row.get(field):
-                    seen.add(norm(" ".join(row[field])))
-    assert [e.nl for e in suite if norm(e.nl) in seen] == []
+                    seen.add(_norm(" ".join(row[field])))
+    assert [e.nl for e in entries if _norm(e.nl) in seen] == []
 
 
-def test_records_carry_the_references_propositions_and_form():
+def test_the_second_suite_repeats_no_sentence_of_the_first():
+    first = {_norm(e.nl) for e in load_suite(SUITE)}
+    assert [e.nl for e in load_suite(SUITE2) if _norm(e.nl) in first] == []
+
+
+@pytest.mark.parametrize("split", sorted(SUITES))
+def test_records_carry_the_references_propositions_and_form(split):
     """Tests that a record's propositions are its reference's, and prop_N means lifted."""
-    records = suite_records()
+    records = suite_records(split)
     assert len({r.uid for r in records}) == len(records)
+    assert {r.source for r in records} == {split}
     for r in records:
         assert set(r.aps) == {a.name for a in _atoms(r.stl)}
         assert (r.form == "lifted") == all(a.startswith("prop_") for a in r.aps)
