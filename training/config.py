@@ -91,6 +91,9 @@ class DataSettings:
             which all its prompts share, as the prompts of one evaluation run do.
             ``[0]`` trains zero-shot only; ``[0, 5, 20]`` prepares the adapter for the
             few-shot variants as well.
+        repeat: Times each record of a source occurs in an epoch (source name ->
+            count >= 1; sources not named occur once), e.g. ``{nl2tl_timed_train: 2}``
+            to weight a part of the mixture up without a new data version.
     """
 
     split: str = "paper"
@@ -99,9 +102,15 @@ class DataSettings:
     forms: tuple[str, ...] = ("lifted", "grounded")
     limit: int | None = None
     shots: tuple[int, ...] = (0,)
+    repeat: dict[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "forms", tuple(self.forms))
+        if not isinstance(self.repeat, dict) or any(
+                not isinstance(k, int) or isinstance(k, bool) or k < 1
+                for k in self.repeat.values()):
+            raise ConfigError(f"data.repeat must map source names to counts >= 1, "
+                              f"got {self.repeat!r}")
         object.__setattr__(self, "shots", tuple(self.shots))
         if not self.shots or any(not isinstance(k, int) or k < 0 for k in self.shots):
             raise ConfigError(f"data.shots must be a list of counts >= 0, got {self.shots}")

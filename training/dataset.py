@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import torch
 
 from ara.data.normalize import Record
+from ara.errors import ConfigError
 from ara.eval.prompt import STOP, Shot, build_prompt
 from ara.eval.translator import ANSWER_PREFIX
 
@@ -57,6 +58,22 @@ def collate(batch: Sequence[Example], pad_id: int) -> dict[str, torch.Tensor]:
         mask[i, : len(seq)] = 1
         labels[i, len(e.prompt_ids): len(seq)] = torch.tensor(e.answer_ids)
     return {"input_ids": ids, "attention_mask": mask, "labels": labels}
+
+
+def repeat_sources(records: Sequence[Record], repeat: dict[str, int]) -> list[Record]:
+    """``records`` with each record of a source in ``repeat`` occurring that many times
+    (in place, so the seeded shuffle of :func:`batches` spreads the copies).
+
+    Raises:
+        ConfigError: If ``repeat`` names a source that no record has, which is a typo
+            or a mixture without that source, and would otherwise weight nothing.
+    """
+    sources = {r.source for r in records}
+    unknown = sorted(set(repeat) - sources)
+    if unknown:
+        raise ConfigError(f"data.repeat names sources the training records lack: {unknown}; "
+                          f"they have {sorted(sources)}")
+    return [r for r in records for _ in range(repeat.get(r.source, 1))]
 
 
 def batches(items: Sequence, batch_size: int, seed: int, epoch: int,

@@ -30,6 +30,7 @@ from ara.training.dataset import (
     batches,
     collate,
     encode,
+    repeat_sources,
     shot_rng,
 )
 
@@ -112,7 +113,7 @@ class LoRAFinetuneRecipe:
         records = [r for f in self.config.data.forms for r in split.records("train", f)]
         if self.config.data.limit:
             records = records[: self.config.data.limit]
-        return records, split
+        return repeat_sources(records, self.config.data.repeat), split
 
     def _lora_model(self):
         from peft import LoraConfig, get_peft_model

@@ -31,6 +31,8 @@ def test_shipped_configs_load_and_round_trip(path):
         ({"data": {"shots": []}}, "counts >= 0"),
         ({"data": {"version": "v3"}}, "12 hex digits"),
         ({"keep_checkpoints": 0}, "keep_checkpoints must be >= 1"),
+        ({"data": {"repeat": {"nl2tl_timed_train": 0}}}, "counts >= 1"),
+        ({"data": {"repeat": ["nl2tl_timed_train"]}}, "counts >= 1"),
     ],
 )
 def test_bad_configs_say_what_is_wrong(data, message):

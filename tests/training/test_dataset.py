@@ -5,8 +5,9 @@ import random
 import pytest
 
 from ara.data.normalize import Record
+from ara.errors import ConfigError
 from ara.eval.prompt import build_prompt
-from ara.training.dataset import batch_shots, batches, encode
+from ara.training.dataset import batch_shots, batches, encode, repeat_sources
 
 
 def record(row: int, form: str = "lifted") -> Record:
@@ -52,3 +53,19 @@ def test_prompts_are_the_evaluation_prompt_with_the_same_shots(hf_model_dir):
     prompt = build_prompt(POOL[0].nl, POOL[0].aps, shots)
     assert list(example.prompt_ids) == tokenizer(prompt)["input_ids"]
     assert tokenizer.decode(example.answer_ids) == f" {POOL[0].stl}\n"
+
+
+def test_repeat_weights_a_source_up_and_leaves_the_others_alone():
+    """Tests ``data.repeat``: twice the timed rows, the rest once, and a source no
+    record has is refused instead of weighting nothing."""
+    timed = [Record(uid=f"t{i}", nl=f"within {i} steps (prop_1)", stl=f"F[0,{i}](prop_1)",
+                    aps=("prop_1",), source="nl2tl_timed_train", form="lifted", row=i)
+             for i in range(1, 4)]
+    mixed = POOL[:6] + timed
+    weighted = repeat_sources(mixed, {"nl2tl_timed_train": 2})
+    assert len(weighted) == 6 + 2 * 3
+    assert [r.uid for r in weighted].count("t1") == 2
+    assert [r for r in weighted if r.source == "navi"] == POOL[:6]
+    assert repeat_sources(mixed, {}) == mixed
+    with pytest.raises(ConfigError, match="lack: \\['nl2tl_timed'\\]"):
+        repeat_sources(mixed, {"nl2tl_timed": 2})
