@@ -29,14 +29,12 @@ def demo_cmd(
     """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
     import lark
 
-    from ara.data import prepare
+    from ara.data import SPLITS, prepare
     from ara.eval.llama_check import LlamaGrammarChecker
     from ara.grammars import Syntax, build_grammar, parse
     from ara.grammars.spot_bridge import equivalent, implies
 
     typer.echo("== data: versioned splits")
-    from ara.data.store import SPLITS
-
     for split in SPLITS:
         p = prepare(split, 0)
         counts = ", ".join(f"{k} {sum(v.values())}" for k, v in p.manifest["counts"].items())

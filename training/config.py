@@ -93,7 +93,8 @@ class DataSettings:
             few-shot variants as well.
         repeat: Times each record of a source occurs in an epoch (source name ->
             count >= 1; sources not named occur once), e.g. ``{nl2tl_timed_train: 2}``
-            to weight a part of the mixture up without a new data version.
+            to weight a part of the mixture up without a new data version. The copies
+            count in ``train_examples`` and are drawn as worked examples as often.
     """
 
     split: str = "paper"
@@ -106,11 +107,6 @@ class DataSettings:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "forms", tuple(self.forms))
-        if not isinstance(self.repeat, dict) or any(
-                not isinstance(k, int) or isinstance(k, bool) or k < 1
-                for k in self.repeat.values()):
-            raise ConfigError(f"data.repeat must map source names to counts >= 1, "
-                              f"got {self.repeat!r}")
         object.__setattr__(self, "shots", tuple(self.shots))
         if not self.shots or any(not isinstance(k, int) or k < 0 for k in self.shots):
             raise ConfigError(f"data.shots must be a list of counts >= 0, got {self.shots}")
@@ -122,6 +118,11 @@ class DataSettings:
                               f"see data/versions.json) or null, got {self.version!r}")
         if self.limit is not None and self.limit < 1:
             raise ConfigError(f"data.limit must be >= 1 or null, got {self.limit}")
+        if not isinstance(self.repeat, dict) or any(
+                not isinstance(k, int) or isinstance(k, bool) or k < 1
+                for k in self.repeat.values()):
+            raise ConfigError(f"data.repeat must map source names to counts >= 1, "
+                              f"got {self.repeat!r}")
 
 
 @dataclass(frozen=True)
