@@ -26,6 +26,12 @@ conditions or lasting actions where version 2 said any command around "whenever"
 adds the visit pattern and "in that order" / "in any order". Version 3.1 brings back
 actions as triggers, said as events (3.0 left none, and the fine-tune on it wrote
 ``F(pick -> F(place))`` for the help request), and "stop" as a lasting action.
+Version 3.2 (after the misses every 3.1 fine-tune shared on the first hand-written
+suite) says a Boolean operand over propositions plainly too ("always a or b" is
+``G(a | b)``, so ``G(a) | b`` is said "always a, or b"), has words for a place's
+negation ("stay out of the kitchen"), draws ``G(a -> !b)`` as a pattern of its own,
+and adds wordings of bounded reach ("at least once in the next 10 steps") and of
+avoidance until a goal ("reach b, but do not a before that").
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -66,7 +72,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.1.0"
+SYNTHETIC_VERSION = "3.2.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -122,6 +128,7 @@ def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) 
         lambda: Eventually(And((a, Eventually(b)))),
         lambda: Eventually(And((a, Eventually(And((b, Eventually(leaf()))))))),
         lambda: Always(Implies(a, Eventually(b, bounded))), lambda: Always(Implies(a, b)),
+        lambda: Always(Implies(a, Not(b))),
         lambda: Until(a, b, iv), lambda: Until(Not(a), b),
         lambda: Implies(a, Eventually(b, iv)), lambda: Eventually(a, iv),
         lambda: Always(Not(a), iv),
@@ -239,9 +246,10 @@ def _lifted_atom(rng: random.Random) -> Callable[[str], str]:
 
 
 def _word(f: Formula, rng: random.Random, mode: str, say, is_action,
-          is_lasting=lambda name: False) -> str:
+          is_lasting=lambda name: False, say_negated=lambda name: None) -> str:
     return realize(f, Realizer(rng=rng, mode=mode, unit=rng.randrange(len(UNITS)),
-                               say_atom=say, is_action=is_action, is_lasting=is_lasting))
+                               say_atom=say, is_action=is_action, is_lasting=is_lasting,
+                               say_negated=say_negated))
 
 
 @dataclass(frozen=True)
@@ -317,9 +325,10 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}
     phrase = {p.name: rng.choice(p.phrases) for p in props}
+    negated = {p.name: rng.choice(p.negated) for p in props if p.negated}
     grounded_nl = _word(grounded, rng, mode, phrase.__getitem__,
                         lambda name: by_name[name].action,
-                        lambda name: by_name[name].lasting)
+                        lambda name: by_name[name].lasting, negated.get)
     return lifted, lifted_nl, grounded, grounded_nl
 
 

@@ -82,6 +82,9 @@ PLACE_STATES = (("in", ("the robot is in the {x}", "you are in the {x}")),
                 ("person_in", ("a person is in the {x}", "someone is in the {x}")))
 OBJECT_STATES = (("holding", ("the robot is holding the {x}", "the {x} is in the gripper")),
                  ("seen", ("the {x} is visible", "the robot sees the {x}")))
+#: Words for a place's negation: "stay out of the kitchen" is ``!in_kitchen``.
+NEGATED = {"in": ("stay out of the {x}", "keep out of the {x}", "stay away from the {x}"),
+           "at": ("stay away from the {x}", "keep away from the {x}")}
 
 
 @dataclass(frozen=True)
@@ -94,6 +97,8 @@ class Proposition:
     #: An action that is a state while it lasts ("hold the box", "stay at the dock",
     #: "wait"): after "whenever c" it asks for that state then, not at some later point.
     lasting: bool = False
+    #: How its negation may be said ("stay out of the kitchen"), if there are words for it.
+    negated: tuple[str, ...] = ()
 
 
 #: Verbs of lasting actions (see :attr:`Proposition.lasting`).
@@ -186,7 +191,9 @@ def _about(verb: str, phrases: tuple[str, ...], name: str, words: str,
            action: bool) -> Proposition:
     """``verb_name``, said by each phrasing with the thing's words filled in."""
     filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
-    return Proposition(f"{verb}_{name}", filled, action, lasting=action and verb in LASTING_VERBS)
+    negated = tuple(p.format(x=words) for p in NEGATED.get(verb, ()))
+    return Proposition(f"{verb}_{name}", filled, action, lasting=action and verb in LASTING_VERBS,
+                       negated=negated)
 
 
 def _thing(rng: random.Random, plain, numbered) -> tuple[str, str]:

@@ -52,12 +52,16 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "you need to {a}"),
     "F_n": ("within {n} {u}, {a}", "{a} within {n} {u}", "in the next {n} {u}, {a}",
             "{a} within the next {n} {u}", "no later than {s} {n}, {a}",
-            "{a} in at most {n} {u}", "before {n} {u} have passed, {a}"),
+            "{a} in at most {n} {u}", "before {n} {u} have passed, {a}",
+            "at some point in the next {n} {u}, {a}", "{a} at some point within {n} {u}",
+            "{a} at least once in the next {n} {u}"),
     "F_ab": ("at some point between {s} {lo} and {s} {hi}, {a}",
              "{a} between {lo} and {hi} {u} from now", "within {lo} to {hi} {u}, {a}",
              "{a} sometime from {s} {lo} to {s} {hi}",
              "after {lo} {u} but no later than {hi} {u}, {a}",
-             "at some time in the window from {lo} to {hi} {u}, {a}"),
+             "at some time in the window from {lo} to {hi} {u}, {a}",
+             "between {s} {lo} and {s} {hi}, {a} at least once",
+             "{a} at least once between {lo} and {hi} {u} from now"),
     "G": ("always {a}", "{a} at all times", "at every step, {a}", "{a} forever",
           "it is always the case that {a}", "globally {a}", "{a} all the time",
           "constantly {a}"),
@@ -67,7 +71,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "G_ab": ("from {s} {lo} to {s} {hi}, {a}", "{a} at every step between {lo} and {hi} {u}",
              "throughout the window from {lo} to {hi} {u}, {a}",
              "{a} all the time from {lo} to {hi} {u}",
-             "for each time instant in the next {lo} to {hi} {u}, {a}"),
+             "for each time instant in the next {lo} to {hi} {u}, {a}",
+             "between {s} {lo} and {s} {hi}, {a} the whole time"),
     "never": ("never {a}", "at no time {a}", "{a} must never happen", "must not ever {a}",
               "always avoid {a}", "avoid {a} at all times", "it must never be the case that {a}",
               "under no circumstances {a}", "{a} is never allowed"),
@@ -112,7 +117,9 @@ PHRASES: dict[str, tuple[str, ...]] = {
                   "{l}, the order does not matter"),
     "avoid_until": ("do not {a} until {b}", "{a} must not happen before {b}",
                     "avoid {a} until {b}", "never {a} before {b}",
-                    "wait until {b} before you {a}"),
+                    "wait until {b} before you {a}",
+                    "{b} eventually, but do not {a} before that",
+                    "eventually {b}, and never {a} before that"),
     "U": ("{a} until {b}", "keep {a} until {b}", "{a} holds until {b}",
           "{a} must hold until {b} happens", "continue {a} until {b}",
           "{a} up to the moment {b}"),
@@ -124,14 +131,17 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "->": ("if {a}, then {b}", "{a} implies {b}", "{b} if {a}", "in case {a}, {b}",
            "provided that {a}, {b}", "{a} means that {b}"),
     "<->": ("{a} if and only if {b}", "{a} exactly when {b}", "{a} is equivalent to {b}",
-            "{a} precisely when {b}", "{a} when and only when {b}"),
+            "{a} precisely when {b}", "{a} when and only when {b}",
+            "{a}, if and only if {b}"),
     "&": ("{a} and {b}", "{a}, and also {b}", "{a} as well as {b}", "{a}, and {b}"),
     "|": ("{a} or {b}", "{a}, or else {b}", "{a} or alternatively {b}", "{a}, or {b}"),
     "!": ("not {a}", "it is not the case that {a}", "{a} does not hold"),
     "!act": ("do not {a}", "don't {a}"),
-    # Bracketing forms: a binary subformula under another operator.
-    "&()": ("both {a} and {b}", "{a} and at the same time {b}"),
-    "|()": ("either {a} or {b}", "at least one of {a} or {b}"),
+    # Bracketing forms: a binary subformula under another operator. The plain ones
+    # ("always a or b" for G(a | b), as people say it) only over propositions: see
+    # _say for why that reading is never given to G(a) | b.
+    "&()": ("both {a} and {b}", "{a} and at the same time {b}", "{a} and {b}"),
+    "|()": ("either {a} or {b}", "at least one of {a} or {b}", "{a} or {b}"),
     "->()": ("if {a} then {b}",),
     "<->()": ("{a} exactly when {b}", "{a} if and only if {b}"),
     "U()": ("{a} until {b}",),
@@ -169,6 +179,8 @@ UNITS: tuple[tuple[str, str | None], ...] = (
     ("steps", "step"), ("time steps", "time step"), ("time units", None), ("seconds", None),
 )
 MODES = ("all", "train", "test")
+#: Plain bracketing forms, said only when every operand is a proposition or its negation.
+PLAIN = frozenset({"{a} and {b}", "{a} or {b}"})
 
 
 @dataclass(frozen=True)
@@ -186,6 +198,9 @@ class Realizer:
         is_lasting: Whether an action is a state while it lasts ("hold the box"):
             "whenever c, hold the box" asks for it then, so the response idiom
             ``G(c -> F(b))`` never says such a ``b`` as the bare command.
+        say_negated: How ``!name`` is said where the language has a word for it
+            ("stay out of the kitchen" for ``!in_kitchen``), else ``None``; used in
+            sampled sentences only, half the time, under ``G`` and in invariants.
     """
 
     rng: random.Random | None = None
@@ -194,6 +209,7 @@ class Realizer:
     say_atom: Callable[[str], str] = field(default=lambda name: name)
     is_action: Callable[[str], bool] = field(default=lambda name: False)
     is_lasting: Callable[[str], bool] = field(default=lambda name: False)
+    say_negated: Callable[[str], str | None] = field(default=lambda name: None)
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -202,11 +218,12 @@ class Realizer:
             raise ConfigError(f"unit must index UNITS (0..{len(UNITS) - 1}), got {self.unit}")
 
     def pick(self, construct: str, used: list[str] | None = None, first: int = 0,
-             **slots: object) -> str:
+             allow: Callable[[str], bool] | None = None, **slots: object) -> str:
         """One phrasing of ``construct`` with its slots filled; without an ``rng``, the
-        one at index ``first``."""
+        one at index ``first``, or the first after it that ``allow`` admits."""
         plural, singular = UNITS[self.unit]
-        options = [p for p in PHRASES[construct] if singular is not None or "{s}" not in p]
+        options = [p for p in PHRASES[construct] if (singular is not None or "{s}" not in p)
+                   and (allow is None or allow(p))]
         held = HELD_OUT.get(construct, frozenset())
         if self.mode == "train":
             options = [p for p in options if p not in held] or options
@@ -214,7 +231,12 @@ class Realizer:
             preferred = [p for p in options if p in held]
             if preferred and self.rng.random() < 0.7:
                 options = preferred
-        phrase = PHRASES[construct][first] if self.rng is None else self.rng.choice(options)
+        if self.rng is None:
+            phrase = PHRASES[construct][first]
+            if allow is not None and not allow(phrase):
+                phrase = next(p for p in PHRASES[construct] if allow(p))
+        else:
+            phrase = self.rng.choice(options)
         if used is not None:
             used.append(f"{construct}:{PHRASES[construct].index(phrase)}")
         return phrase.format(u=plural, s=singular, **slots)
@@ -243,9 +265,11 @@ def realize(formula: Formula, realizer: Realizer, used: list[str] | None = None)
 
 
 def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
-         now: bool = False) -> str:
+         now: bool = False, plain: bool = True) -> str:
     """``now``: ``f`` is read at the first instant (outside every temporal operator),
-    where a bare command ("go to the kitchen") means "at some point"."""
+    where a bare command ("go to the kitchen") means "at some point". ``plain``: a
+    Boolean ``f`` may take a plain bracketing form; not under another ``&`` or ``|``,
+    where "either a or b and c" would hide the scope."""
     visits = None if embedded or r.rng is None else _visits(f)
     if visits is not None and r.rng.random() < 0.5:
         said = [_say(g, r, used, embedded=True) for g in visits]
@@ -279,18 +303,54 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
     if isinstance(f, (And, Or)):
         op = "&" if isinstance(f, And) else "|"
         key = op + "()" if embedded else op
-        text = sub_now(f.args[0])
-        for arg in f.args[1:]:
+        plain = plain and all(_is_literal(g) for g in f.args)
+
+        def operand(g: Formula) -> str:
+            return _say(g, r, used, embedded=True, now=now, plain=False)
+
+        text = operand(f.args[0])
+        for left, arg in zip(f.args, f.args[1:], strict=False):
             # A comma keeps "first a, then b, and never c" from reading as one sequence.
             comma = 3 if not embedded and " " in text else 0
-            text = r.pick(key, used, first=comma, a=text, b=sub_now(arg))
+            allow = (lambda p: plain or p not in PLAIN) if embedded else _scoped(left, arg)
+            text = r.pick(key, used, first=comma, allow=allow, a=text, b=operand(arg))
         return text
     if isinstance(f, Until):
         if f.interval is None:
             return r.pick("U()" if embedded else "U", used, a=sub(f.lhs), b=sub(f.rhs))
         return _timed("U", f.interval, r, used, a=sub(f.lhs), b=sub(f.rhs))
     op = "->" if isinstance(f, Implies) else "<->"
-    return r.pick(op + "()" if embedded else op, used, a=sub_now(f.lhs), b=sub_now(f.rhs))
+    if embedded:
+        return r.pick(op + "()", used, a=sub_now(f.lhs), b=sub_now(f.rhs))
+    return r.pick(op, used, allow=_scoped(f.lhs, f.rhs), a=sub_now(f.lhs), b=sub_now(f.rhs))
+
+
+def _is_literal(f: Formula) -> bool:
+    return isinstance(f, (Atom, Const)) or (isinstance(f, Not) and isinstance(f.arg, Atom))
+
+
+def _scoped(lhs: Formula, rhs: Formula) -> Callable[[str], bool] | None:
+    """Which phrasings of a top-level ``lhs op rhs`` keep ``op`` outside ``lhs``.
+
+    "always a or b" is how people say ``G(a | b)`` (the plain bracketing form), so
+    ``G(a) | b`` must not be said that way: when ``lhs`` is more than a proposition and
+    ``rhs`` a proposition, a phrasing must set ``lhs`` off with a comma ("always a, or
+    b") or not begin with it ("b if always a").
+    """
+    if _is_literal(lhs) or not _is_literal(rhs):
+        return None
+    return lambda p: p.startswith("{a},") or not p.startswith("{a}")
+
+
+def _negated(f: Not, r: Realizer) -> str | None:
+    """The word for ``!name`` ("stay out of the kitchen"), in half the sampled
+    sentences where there is one. Said only where ``!name`` holds throughout (under
+    ``G``, or what an invariant asks for): "eventually stay out of the kitchen" would
+    read as F(G(!in_kitchen)), not F(!in_kitchen)."""
+    if r.rng is None or not isinstance(f.arg, Atom):
+        return None
+    said = r.say_negated(f.arg.name)
+    return said if said is not None and r.rng.random() < 0.5 else None
 
 
 def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | None,
@@ -313,6 +373,9 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
 
     if isinstance(f, Always) and isinstance(f.arg, Not) and (
             f.interval is None or f.interval.hi is not None):
+        negated = _negated(f.arg, r)
+        if negated is not None:  # "always stay out of the kitchen"
+            return _timed("G", f.interval, r, used, a=negated)
         return _timed("never", f.interval, r, used, a=sub(f.arg.arg))
     if isinstance(f, Eventually) and f.interval is None and isinstance(f.arg, Always) \
             and f.arg.interval is None:
@@ -331,7 +394,8 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
             if rhs.interval is None:
                 return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
             return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
-        return r.pick("invariant", used, a=sub(lhs), b=sub(rhs))
+        said = _negated(rhs, r) if isinstance(rhs, Not) else None
+        return r.pick("invariant", used, a=sub(lhs), b=said or sub(rhs))
     steps = _sequence(f)
     if steps is not None and len(steps) == 2:
         return r.pick("sequence", used, a=sub(steps[0]), b=sub(steps[1]))

@@ -1,18 +1,20 @@
 #!/usr/bin/env bash
-# The shipped fine-tune, end to end, on a CPU: five training runs of 40 to 85 min on 2
+# The shipped fine-tune, end to end, on a CPU: six training runs of 40 to 85 min on 2
 # cores on the compositional mixtures (each fits one session), the average of the last
-# two (a "soup"), then export, ship and the evaluations (about 45 min).
+# three (a "soup"), then export, ship and the evaluations (about 45 min).
 #
-#   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 soup export ship
-#                                         eval paper disjoint full
-#                                         (default: all of them from train to eval)
+#   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 v10 soup export
+#                                         ship eval paper disjoint full
+#                                         (default: all of them from train to eval but v9)
 #
 # train: v3 (training/configs/gemma3_270m_lora_cpu_compositional.yaml); continue: v4,
 #   400 more steps from v3's adapter (..._compositional_v4.yaml); v6, v7, v8: three more
 #   runs from v4's adapter (v6 on mixture 820c2d11c0c8; v7 300 steps and v8, from v6's
-#   adapter, 150 steps, both on 6c3132045205); soup: the mean of v7's and v8's adapters
-#   (`ara soup`); export/ship: the soup becomes `--model finetuned`. v9 (not in the
-#   default steps): v7's config with another seed, the seed study of docs/generalization.md.
+#   adapter, 150 steps, both on 6c3132045205); v10: v7's config with NL2TL's timed rows
+#   counted twice; soup: the mean of v7's, v8's and v10's adapters (`ara soup`, from the
+#   adapters committed under docs/results/training/); export/ship: the soup becomes
+#   `--model finetuned`. v9 (not in the default steps): v7's config with another seed,
+#   the seed study of docs/generalization.md.
 # eval: the generalization runs of the new adapter, the paper-split adapter and the base
 #   model (scripts/eval_generalization.sh), the round trip, the help-request wordings.
 # paper: retrains the paper-split adapter (`--model finetuned-paper`, Table I) from its
@@ -31,7 +33,7 @@ v4_run=runs/train/gemma3-270m-lora-compositional-v4
 run=runs/train/gemma3-270m-lora-compositional-soup
 paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
-steps=${*:-train continue v6 v7 v8 soup export ship eval}
+steps=${*:-train continue v6 v7 v8 v10 soup export ship eval}
 
 train() {  # CONFIG RUN_FOLDER
   if [ -f "$2/run.json" ]; then resume=--resume; else resume=; fi
@@ -79,12 +81,13 @@ for step in $steps; do
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
     train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
-  v6|v7|v8|v9)
+  v6|v7|v8|v9|v10)
     train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
       "runs/train/gemma3-270m-lora-compositional-$step" ;;
   soup)
-    $bin/ara soup --run runs/train/gemma3-270m-lora-compositional-v7 \
-      --run runs/train/gemma3-270m-lora-compositional-v8 --out "$run" ;;
+    # The committed records of the parts; a rerun's parts are in runs/train/..-vN
+    parts=docs/results/training/compositional-270m
+    $bin/ara soup --run $parts-v7 --run $parts-v8 --run $parts-v10 --out "$run" ;;
   export)
     # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
     $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
@@ -114,7 +117,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 v9 soup export ship eval paper disjoint full)" >&2
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 soup export ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac
 done

@@ -53,7 +53,11 @@ MODELS = {
     "soup-v4v7v8-270m": ("soup v4+v7+v8 (not shipped)", ("compositional", "6c3132045205")),
     "soup-v7v8v9-270m": ("soup v7+v8+v9 (not shipped)", ("compositional", "6c3132045205")),
     "soup-v7v9-270m": ("soup v7+v9 (not shipped)", ("compositional", "6c3132045205")),
-    "compositional-adapter-270m": ("soup v7+v8 (shipped)", ("compositional", "6c3132045205")),
+    "compositional-adapter-v10-270m": ("compositional adapter v10 (v7, timed rows x2)",
+                                       ("compositional", "6c3132045205")),
+    "soup-v7v8-270m": ("soup v7+v8 (shipped before)", ("compositional", "6c3132045205")),
+    "compositional-adapter-270m": ("soup v7+v8+v10 (shipped)",
+                                   ("compositional", "6c3132045205")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("handwritten2", "lifted"), ("handwritten2", "grounded"),

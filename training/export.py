@@ -83,7 +83,10 @@ def merge_adapter(base_dir: str, adapter_dir: str, out: Path) -> Path:
                                                 dtype=torch.float32)
     merged = PeftModel.from_pretrained(base, adapter_dir).merge_and_unload()
     merged.save_pretrained(out)
-    AutoTokenizer.from_pretrained(adapter_dir).save_pretrained(out)
+    # A training run saves the tokenizer beside its adapter; a soup of committed
+    # adapters has none, and the base's is the same one
+    has_own = Path(adapter_dir, "tokenizer.json").is_file()
+    AutoTokenizer.from_pretrained(adapter_dir if has_own else base_dir).save_pretrained(out)
     return out
 
 

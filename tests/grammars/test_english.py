@@ -122,3 +122,40 @@ def test_realizer_settings_are_checked():
         Realizer(mode="dev")
     with pytest.raises(ConfigError, match="unit must index"):
         Realizer(unit=9)
+
+
+def test_a_plain_or_scopes_inside_and_a_comma_sets_the_outer_one_off():
+    """Tests that "always a or b" is taught as G(a | b), the way people say it, and
+    never as G(a) | b, which is said with a comma or not begun by its left side."""
+
+    def sayings(formula: str) -> set[str]:
+        f = parse(formula)
+        return {realize(f, Realizer(rng=random.Random(seed), mode="train")).rstrip(".").lower()
+                for seed in range(300)}
+
+    inside = sayings("G(a | b)")
+    assert {"always a or b", "a or b at all times"} & inside
+    outside = sayings("G(a) | b")
+    assert not [s for s in outside if s.endswith(" or b") and ", or" not in s]
+    # The plain form is only for propositions: "always a or b and c" would be ambiguous
+    assert not [s for s in sayings("G(a | (b & c))") if "or b and c" in s]
+    assert explain(parse("G(a) <-> b")) == "always a, if and only if b"
+
+
+def test_a_place_left_alone_has_its_own_words():
+    """Tests that !in_kitchen may be said "stay out of the kitchen", under G as under
+    an implication, and that explain, which has no such words, keeps "never"."""
+    said = {"in_kitchen": "you are in the kitchen", "wet": "the floor is wet"}
+    realizer = Realizer(rng=random.Random(0), mode="train", say_atom=said.__getitem__,
+                        say_negated={"in_kitchen": "stay out of the kitchen"}.get)
+    always = {realize(parse("G(!in_kitchen)"), realizer).rstrip(".").lower()
+              for _ in range(100)}
+    assert "always stay out of the kitchen" in always
+    assert [s for s in always if "never" in s or "avoid" in s]  # the idiom stays too
+    guarded = {realize(parse("G(wet -> !in_kitchen)"), realizer).rstrip(".").lower()
+               for _ in range(200)}
+    assert "stay out of the kitchen while the floor is wet" in guarded
+    assert explain(parse("G(!in_kitchen)")) == "never in_kitchen"
+    # "stay out of" lasts: never for a single instant without G
+    once = {realize(parse("F(!in_kitchen)"), realizer).lower() for _ in range(100)}
+    assert not [s for s in once if "stay out" in s]

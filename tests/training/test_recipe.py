@@ -211,3 +211,21 @@ def test_a_step_of_several_micro_batches_logs_all_of_them(tiny_gemma_dir, tmp_pa
     assert [x["step"] for x in log] == [1, 2] and len(losses) == 2
     assert all(isinstance(x["shots"], list) and len(x["shots"]) == 2 for x in log)
     assert [x["loss"] for x in log] == [round(v, 5) for v in losses]
+
+
+def test_merging_an_adapter_saved_without_a_tokenizer_takes_the_bases(tiny_gemma_dir, tmp_path):
+    """A soup of committed adapters has no tokenizer beside it (runs save one, the
+    committed records do not): the merged folder gets the base model's, so that
+    `ara export` of such a soup still makes a complete HF folder."""
+    from peft import LoraConfig, get_peft_model
+    from transformers import AutoModelForCausalLM, AutoTokenizer
+
+    from ara.training.export import merge_adapter
+
+    model = AutoModelForCausalLM.from_pretrained(tiny_gemma_dir)
+    get_peft_model(model, LoraConfig(r=2, lora_alpha=4, target_modules="all-linear")
+                   ).save_pretrained(tmp_path / "adapter")
+    assert not (tmp_path / "adapter" / "tokenizer.json").exists()
+    merged = merge_adapter(str(tiny_gemma_dir), str(tmp_path / "adapter"), tmp_path / "merged")
+    ours, base = (AutoTokenizer.from_pretrained(d) for d in (merged, tiny_gemma_dir))
+    assert ours("always ( prop_1 )")["input_ids"] == base("always ( prop_1 )")["input_ids"]
