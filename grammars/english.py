@@ -219,8 +219,9 @@ class Realizer:
 
     def pick(self, construct: str, used: list[str] | None = None, first: int = 0,
              allow: Callable[[str], bool] | None = None, **slots: object) -> str:
-        """One phrasing of ``construct`` with its slots filled; without an ``rng``, the
-        one at index ``first``, or the first after it that ``allow`` admits."""
+        """One phrasing of ``construct`` with its slots filled, among those ``allow``
+        admits; without an ``rng``, the one at index ``first``, or if ``allow`` refuses
+        it, the first phrasing that ``allow`` admits."""
         plural, singular = UNITS[self.unit]
         options = [p for p in PHRASES[construct] if (singular is not None or "{s}" not in p)
                    and (allow is None or allow(p))]
