@@ -3,7 +3,8 @@ worded by the English realizer (:mod:`ara.grammars.english`).
 
 Most formulas are what users write: 40% one pattern (reach, avoid, two- and
 three-step sequence, visits in any order, response, recurrence, persistence, bounded
-reach and avoid, until), 30% two patterns joined by a connective, 15% three patterns
+reach and avoid, until, patrolling, a moment and what holds from then on, exactly one
+of two), 30% two patterns joined by a connective, 15% three patterns
 that must all hold, each as deep as the decoding grammar allows (5); the other 15% grow
 at random over every operator of the grammar (``!``, ``&``, ``|``, ``->``, ``<->``,
 ``F``, ``G``, ``U``, each temporal one timed or not) up to depth 4. A pattern's operand is now
@@ -31,7 +32,13 @@ suite) says a Boolean operand over propositions plainly too ("always a or b" is
 ``G(a | b)``, so ``G(a) | b`` is said "always a, or b"), has words for a place's
 negation ("stay out of the kitchen"), draws ``G(a -> !b)`` as a pattern of its own,
 and adds wordings of bounded reach ("at least once in the next 10 steps") and of
-avoidance until a goal ("reach b, but do not a before that").
+avoidance until a goal ("reach b, but do not a before that"). Version 3.3 adds the
+idioms users reach for that no earlier version said: being somewhere for good or again
+and again ("go to the dock and stay there" ``F(G(at_dock))``, "keep coming back to the
+dock" ``G(F(at_dock))``, "patrol between a and b"), "a, and from then on always b"
+(``F(a & G(b))``), "a or b, but not both", "a only if b" / "a only when b" and "never
+a and b at the same time"; patrolling, ``F(a & G(b))`` and exactly-one-of are patterns
+of their own.
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -72,7 +79,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.2.0"
+SYNTHETIC_VERSION = "3.3.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -135,8 +142,19 @@ def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) 
         # Visits in any order (Menghi et al.'s "visit" mission pattern)
         lambda: And((Eventually(a), Eventually(b))),
         lambda: And((And((Eventually(a), Eventually(b))), Eventually(leaf()))),
+        # Patrolling (Menghi et al.'s "patrolling"), a moment and what holds from then
+        # on, exactly one of two (of two goals half the time)
+        lambda: And((Always(Eventually(a)), Always(Eventually(b)))),
+        lambda: Eventually(And((a, Always(b)))),
+        lambda: _exactly_one(*((Eventually(a), Eventually(b)) if rng.random() < 0.5
+                               else (a, b))),
     ]
     return rng.choice(choices)()
+
+
+def _exactly_one(a: Formula, b: Formula) -> Formula:
+    """``(a | b) & !(a & b)``."""
+    return And((Or((a, b)), Not(And((a, b)))))
 
 
 def _random(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula],
@@ -246,10 +264,11 @@ def _lifted_atom(rng: random.Random) -> Callable[[str], str]:
 
 
 def _word(f: Formula, rng: random.Random, mode: str, say, is_action,
-          is_lasting=lambda name: False, say_negated=lambda name: None) -> str:
+          is_lasting=lambda name: False, say_negated=lambda name: None,
+          say_place=lambda name: None) -> str:
     return realize(f, Realizer(rng=rng, mode=mode, unit=rng.randrange(len(UNITS)),
                                say_atom=say, is_action=is_action, is_lasting=is_lasting,
-                               say_negated=say_negated))
+                               say_negated=say_negated, say_place=say_place))
 
 
 @dataclass(frozen=True)
@@ -263,6 +282,10 @@ class Roles:
     states: frozenset[str]
     #: A condition or an achievement said as an event ("you pick up the box").
     triggers: frozenset[str]
+    #: What is reached for good or again and again (``a`` in ``F(G(a))``, ``G(F(a))``)
+    #: or kept false by ``G`` (``G(!a)``, ``G(c -> !a)``), which may be being somewhere
+    #: ("go to the dock and stay there", "stay out of the kitchen").
+    places: frozenset[str] = frozenset()
 
 
 def roles_of(f: Formula) -> Roles:
@@ -292,8 +315,18 @@ def roles_of(f: Formula) -> Roles:
                 if isinstance(n, Always) and n.interval is None
                 and isinstance(n.arg, Implies) and isinstance(n.arg.lhs, Atom)
                 and occurrences[n.arg.lhs.name] == 1}
+    places = {n.arg.arg.name for n in walk(f)
+              if isinstance(n, (Eventually, Always)) and n.interval is None
+              and isinstance(n.arg, Always if isinstance(n, Eventually) else Eventually)
+              and n.arg.interval is None and isinstance(n.arg.arg, Atom)}
+    # What G keeps false, at once or after a condition: "stay out of the kitchen"
+    for n in walk(f):
+        kept = n.arg.rhs if isinstance(n, Always) and isinstance(n.arg, Implies) else \
+            n.arg if isinstance(n, Always) else None
+        if isinstance(kept, Not) and isinstance(kept.arg, Atom):
+            places.add(kept.arg.name)
     return Roles(frozenset(conditions - triggers), frozenset(states - conditions),
-                 frozenset(triggers))
+                 frozenset(triggers), frozenset(places - conditions - states - triggers))
 
 
 def pair(rng: random.Random, s: SynthSettings, mode: str,
@@ -312,7 +345,8 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
         numbers = rng.sample(range(1, len(used) + 1), len(used))
         lifted_names = {x: f"prop_{n}" for x, n in zip(used, numbers, strict=True)}
     lifted = rename_atoms(f, lifted_names)
-    lifted_nl = _word(lifted, rng, mode, _lifted_atom(rng), lambda name: False)
+    say_lifted = _lifted_atom(rng)
+    lifted_nl = _word(lifted, rng, mode, say_lifted, lambda name: False, say_place=say_lifted)
     roles = roles_of(f)
 
     def indices(names: frozenset[str]) -> frozenset[int]:
@@ -320,7 +354,7 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
 
     props: list[Proposition] = draw_propositions(
         rng, len(used), conditions=indices(roles.conditions), states=indices(roles.states),
-        triggers=indices(roles.triggers))
+        triggers=indices(roles.triggers), places=indices(roles.places))
     by_x = dict(zip(used, props, strict=True))
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}
@@ -328,7 +362,8 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
     negated = {p.name: rng.choice(p.negated) for p in props if p.negated}
     grounded_nl = _word(grounded, rng, mode, phrase.__getitem__,
                         lambda name: by_name[name].action,
-                        lambda name: by_name[name].lasting, negated.get)
+                        lambda name: by_name[name].lasting, negated.get,
+                        lambda name: by_name[name].place)
     return lifted, lifted_nl, grounded, grounded_nl
 
 

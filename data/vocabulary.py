@@ -99,19 +99,26 @@ class Proposition:
     lasting: bool = False
     #: How its negation may be said ("stay out of the kitchen"), if there are words for it.
     negated: tuple[str, ...] = ()
+    #: The place it is about ("the kitchen"), for being somewhere ("in", "at"): then
+    #: F(G(.)) may be said "go to the kitchen and stay there".
+    place: str | None = None
 
 
 #: Verbs of lasting actions (see :attr:`Proposition.lasting`).
 LASTING_VERBS = frozenset({"at", "hold", "wait", "stop"})
+#: Verbs of being somewhere (see :attr:`Proposition.place`).
+BEING_AT = frozenset({"at", "in"})
 
 
 def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = frozenset(),
                       states: frozenset[int] = frozenset(),
-                      triggers: frozenset[int] = frozenset()) -> list[Proposition]:
+                      triggers: frozenset[int] = frozenset(),
+                      places: frozenset[int] = frozenset()) -> list[Proposition]:
     """``k`` propositions with distinct names, mixing actions and conditions; the ones
     at the indices in ``conditions`` are conditions, those in ``states`` a condition or
     a lasting action, those in ``triggers`` a condition or an achievement said as an
-    event, half and half."""
+    event, half and half; those in ``places`` (and none of the others) are being
+    somewhere half the time."""
     found: dict[str, Proposition] = {}
     while len(found) < k:
         i = len(found)
@@ -121,6 +128,8 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_event(rng)
         elif i in states:
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_lasting(rng)
+        elif i in places and rng.random() < 0.5:
+            prop = _draw_being_at(rng)
         else:
             prop = _draw_one(rng)
         found.setdefault(prop.name, prop)
@@ -139,6 +148,15 @@ def _draw_lasting(rng: random.Random) -> Proposition:
         return _about("hold", phrases, name, words, action=True)
     verb = "wait" if kind < 0.93 else "stop"
     return Proposition(verb, dict(STANDALONE_ACTIONS)[verb], action=True, lasting=True)
+
+
+def _draw_being_at(rng: random.Random) -> Proposition:
+    """Being at a place: a lasting action ("stay at the dock") or a condition ("the
+    robot is in the kitchen")."""
+    name, words = _thing(rng, PLACES, NUMBERED_PLACES)
+    if rng.random() < 0.5:
+        return _about("at", dict(PLACE_VERBS)["at"], name, words, action=True)
+    return _about("in", dict(PLACE_STATES)["in"], name, words, action=False)
 
 
 def _draw_event(rng: random.Random) -> Proposition:
@@ -192,8 +210,10 @@ def _about(verb: str, phrases: tuple[str, ...], name: str, words: str,
     """``verb_name``, said by each phrasing with the thing's words filled in."""
     filled = tuple(dict.fromkeys(p.format(x=words) for p in phrases))
     negated = tuple(p.format(x=words) for p in NEGATED.get(verb, ()))
+    # "dock 3", as the numbered places' phrasings say it; "the kitchen"
+    place = (words if words[-1].isdigit() else f"the {words}") if verb in BEING_AT else None
     return Proposition(f"{verb}_{name}", filled, action, lasting=action and verb in LASTING_VERBS,
-                       negated=negated)
+                       negated=negated, place=place)
 
 
 def _thing(rng: random.Random, plain, numbered) -> tuple[str, str]:

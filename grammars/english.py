@@ -7,8 +7,11 @@ construct, a time unit and a sentence layout, so one formula becomes many senten
 
 Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
 often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, then b",
-``!a U b`` "do not a until b"; in sampled sentences also ``F(a) & F(b)`` "a and b, in
-any order", and ``G(a -> F(b))`` with ``b`` a command "whenever a, b". Everything else
+``!a U b`` "do not a until b", ``F(a & G(b))`` "eventually a, and from then on always
+b", ``(a | b) & !(a & b)`` "a or b, but not both"; in sampled sentences also ``F(a) &
+F(b)`` "a and b, in any order", ``G(a -> F(b))`` with ``b`` a command "whenever a, b",
+and over places ``F(G(a))`` "go to a and stay there", ``G(F(a))`` "keep coming back to
+a", ``G(F(a)) & G(F(b))`` "patrol between a and b". Everything else
 is read compositionally, and a binary subformula under another operator is read in its
 bracketing form ("both ... and ...", "either ... or ...") so that the scope survives in
 the sentence.
@@ -64,7 +67,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "{a} at least once between {lo} and {hi} {u} from now"),
     "G": ("always {a}", "{a} at all times", "at every step, {a}", "{a} forever",
           "it is always the case that {a}", "globally {a}", "{a} all the time",
-          "constantly {a}"),
+          "constantly {a}", "{a} the whole time"),
     "G_n": ("for the first {n} {u}, {a}", "{a} for the next {n} {u}",
             "during the first {n} {u}, {a}", "{a} at every step until {s} {n}",
             "for {n} {u}, {a}", "{a} continuously for {n} {u}"),
@@ -85,9 +88,30 @@ PHRASES: dict[str, tuple[str, ...]] = {
            "sooner or later {a} for good", "{a} eventually holds forever",
            "{a} from some point on, forever", "eventually {a} and from then on it stays so",
            "in the end, {a} permanently"),
+    # F(G(a)) and G(F(a)) over a place: where the robot ends up, where it keeps going.
+    "FG_place": ("go to {x} and stay there", "reach {x} and remain there",
+                 "get to {x} and stay there for good", "head to {x} and remain there forever",
+                 "end up at {x} and never leave"),
     "GF": ("{a} infinitely often", "{a} over and over again", "repeatedly {a}",
            "always eventually {a}", "{a} again and again", "keep returning to {a} forever",
            "{a} periodically", "regularly {a}", "{a} time and again"),
+    "GF_place": ("keep coming back to {x}", "return to {x} again and again",
+                 "keep visiting {x} forever", "visit {x} over and over",
+                 "go back to {x} infinitely often"),
+    # G(F(a)) & G(F(b)) over two places: a patrol.
+    "GF2_place": ("patrol between {x} and {y}", "go back and forth between {x} and {y} forever",
+                  "keep visiting {x} and {y}", "keep coming back to {x} and to {y}",
+                  "alternate between {x} and {y} forever"),
+    # F(a & G(b)): a moment, and what holds from it on.
+    "F_then_G": ("eventually {a}, and from then on always {b}",
+                 "at some point {a}, and from that moment on {b} forever",
+                 "{a} at some point, and after that {b} at all times",
+                 "sooner or later {a}, and from then on {b} holds forever",
+                 "eventually {a}; from that point on, always {b}"),
+    # (a | b) & !(a & b)
+    "xor": ("{a} or {b}, but not both", "either {a} or {b}, but not both",
+            "exactly one of {a} and {b}", "{a} or {b}, never both",
+            "{a} or {b}, but not the two together"),
     "response": ("whenever {a}, eventually {b}", "every time {a}, {b} at some later point",
                  "each time {a}, make sure that eventually {b}", "if ever {a}, then eventually {b}",
                  "{a} is always followed by {b}", "any time {a}, sooner or later {b}"),
@@ -102,7 +126,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
                   "at all times, if {a} then {b}", "always, if {a}, then {b}",
                   "while {a}, {b}", "{b} while {a}", "as long as {a}, {b}",
-                  "{b} as long as {a}"),
+                  "{b} as long as {a}", "{a} only when {b}", "{a} only while {b}"),
     "sequence": ("first {a}, then {b}", "{a} and after that {b}", "{a}, and afterwards {b}",
                  "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}",
                  "{a}, then {b}", "{a} first, and {b} afterwards", "after {a}, {b}",
@@ -129,7 +153,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "keep {a} until {b}, which happens within {lo} to {hi} {u}",
              "{a} until, between {lo} and {hi} {u} from now, {b}"),
     "->": ("if {a}, then {b}", "{a} implies {b}", "{b} if {a}", "in case {a}, {b}",
-           "provided that {a}, {b}", "{a} means that {b}"),
+           "provided that {a}, {b}", "{a} means that {b}", "{a} only if {b}"),
     "<->": ("{a} if and only if {b}", "{a} exactly when {b}", "{a} is equivalent to {b}",
             "{a} precisely when {b}", "{a} when and only when {b}",
             "{a}, if and only if {b}"),
@@ -140,7 +164,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
     # Bracketing forms: a binary subformula under another operator. The plain ones
     # ("always a or b" for G(a | b), as people say it) only over propositions: see
     # _say for why that reading is never given to G(a) | b.
-    "&()": ("both {a} and {b}", "{a} and at the same time {b}", "{a} and {b}"),
+    "&()": ("both {a} and {b}", "{a} and at the same time {b}", "{a} and {b}",
+            "{a} and {b} at the same time"),
     "|()": ("either {a} or {b}", "at least one of {a} or {b}", "{a} or {b}"),
     "->()": ("if {a} then {b}",),
     "<->()": ("{a} exactly when {b}", "{a} if and only if {b}"),
@@ -172,6 +197,11 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "U": frozenset({"continue {a} until {b}"}),
     "<->": frozenset({"{a} when and only when {b}"}),
     "|": frozenset({"{a}, or {b}"}),
+    "FG_place": frozenset({"end up at {x} and never leave"}),
+    "GF_place": frozenset({"go back to {x} infinitely often"}),
+    "GF2_place": frozenset({"alternate between {x} and {y} forever"}),
+    "F_then_G": frozenset({"eventually {a}; from that point on, always {b}"}),
+    "xor": frozenset({"{a} or {b}, but not the two together"}),
 }
 
 #: Time units: (plural, singular or None where "step 5" would not read).
@@ -180,7 +210,9 @@ UNITS: tuple[tuple[str, str | None], ...] = (
 )
 MODES = ("all", "train", "test")
 #: Plain bracketing forms, said only when every operand is a proposition or its negation.
-PLAIN = frozenset({"{a} and {b}", "{a} or {b}"})
+PLAIN = frozenset({"{a} and {b}", "{a} or {b}", "{a} and {b} at the same time"})
+#: Commands said bare, as one side of a choice.
+_BARE_DO = frozenset({"{a}", "{a} at some point", "{a} eventually"})
 
 
 @dataclass(frozen=True)
@@ -201,6 +233,10 @@ class Realizer:
         say_negated: How ``!name`` is said where the language has a word for it
             ("stay out of the kitchen" for ``!in_kitchen``), else ``None``; used in
             sampled sentences only, half the time, under ``G`` and in invariants.
+        say_place: The place a proposition is about ("the charging station" for
+            ``at_charging_station``), else ``None``: ``F(G(a))`` may then be said "go to
+            the charging station and stay there" and ``G(F(a))`` "keep coming back to
+            it"; sampled sentences only, half the time.
     """
 
     rng: random.Random | None = None
@@ -210,6 +246,7 @@ class Realizer:
     is_action: Callable[[str], bool] = field(default=lambda name: False)
     is_lasting: Callable[[str], bool] = field(default=lambda name: False)
     say_negated: Callable[[str], str | None] = field(default=lambda name: None)
+    say_place: Callable[[str], str | None] = field(default=lambda name: None)
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -276,7 +313,7 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
         said = [_say(g, r, used, embedded=True) for g in visits]
         listing = " and ".join(said) if len(said) == 2 else f"{', '.join(said[:-1])} and {said[-1]}"
         return r.pick("visit_any", used, l=listing)
-    idiom = _idiom(f, r, used)
+    idiom = _idiom(f, r, used, now)
     if idiom is not None:
         return idiom
 
@@ -323,7 +360,9 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
     op = "->" if isinstance(f, Implies) else "<->"
     if embedded:
         return r.pick(op + "()", used, a=sub_now(f.lhs), b=sub_now(f.rhs))
-    return r.pick(op, used, allow=_scoped(f.lhs, f.rhs), a=sub_now(f.lhs), b=sub_now(f.rhs))
+    scoped, only = _scoped(f.lhs, f.rhs), _only(f.lhs)
+    return r.pick(op, used, allow=lambda p: (scoped is None or scoped(p)) and only(p),
+                  a=sub_now(f.lhs), b=sub_now(f.rhs))
 
 
 def _is_literal(f: Formula) -> bool:
@@ -341,6 +380,12 @@ def _scoped(lhs: Formula, rhs: Formula) -> Callable[[str], bool] | None:
     if _is_literal(lhs) or not _is_literal(rhs):
         return None
     return lambda p: p.startswith("{a},") or not p.startswith("{a}")
+
+
+def _only(lhs: Formula) -> Callable[[str], bool]:
+    """Whether a phrasing may be said: "a only if b" and "a only when b" only for a
+    proposition ``a``, since after "p or q", "only if" would read as binding ``q`` alone."""
+    return lambda p: _is_literal(lhs) or " only " not in p.replace("and only", "")
 
 
 def _negated(f: Not, r: Realizer) -> str | None:
@@ -366,7 +411,21 @@ def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | No
     return r.pick(op + "_ab", used, lo=interval.lo, hi=interval.hi, **slots)
 
 
-def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
+def _place(f: Formula, r: Realizer) -> str | None:
+    """The place ``f`` is about, if it is a proposition with one, in half the sampled
+    sentences."""
+    if r.rng is None or not isinstance(f, Atom):
+        return None
+    said = r.say_place(f.name)
+    return said if said is not None and r.rng.random() < 0.5 else None
+
+
+def _untimed(f: Formula, op: type) -> Formula | None:
+    """The argument of an untimed ``op`` (``Eventually``, ``Always``), else ``None``."""
+    return f.arg if isinstance(f, op) and f.interval is None else None
+
+
+def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -> str | None:
     """The idiomatic reading of a common pattern, or ``None``."""
 
     def sub(g: Formula) -> str:
@@ -378,12 +437,28 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
         if negated is not None:  # "always stay out of the kitchen"
             return _timed("G", f.interval, r, used, a=negated)
         return _timed("never", f.interval, r, used, a=sub(f.arg.arg))
-    if isinstance(f, Eventually) and f.interval is None and isinstance(f.arg, Always) \
-            and f.arg.interval is None:
-        return r.pick("FG", used, a=sub(f.arg.arg))
-    if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Eventually) \
-            and f.arg.interval is None:
-        return r.pick("GF", used, a=sub(f.arg.arg))
+    inner = _untimed(f, Eventually)
+    if inner is not None and _untimed(inner, Always) is not None:
+        place = _place(inner.arg, r)
+        if place is not None:  # "go to the charging station and stay there"
+            return r.pick("FG_place", used, x=place)
+        return r.pick("FG", used, a=sub(inner.arg))
+    inner = _untimed(f, Always)
+    if inner is not None and _untimed(inner, Eventually) is not None:
+        place = _place(inner.arg, r)
+        if place is not None:  # "keep coming back to the charging station"
+            return r.pick("GF_place", used, x=place)
+        return r.pick("GF", used, a=sub(inner.arg))
+    patrol = _patrol(f, r)
+    if patrol is not None:
+        return r.pick("GF2_place", used, x=patrol[0], y=patrol[1])
+    inner = _untimed(f, Eventually)
+    if isinstance(inner, And) and len(inner.args) == 2 \
+            and _untimed(inner.args[1], Always) is not None:
+        return r.pick("F_then_G", used, a=sub(inner.args[0]), b=sub(inner.args[1].arg))
+    if _is_xor(f):
+        one, other = f.args[0].args
+        return r.pick("xor", used, a=_choice(one, r, used, now), b=_choice(other, r, used, now))
     if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies):
         lhs, rhs = f.arg.lhs, f.arg.rhs
         if isinstance(rhs, Eventually) and (rhs.interval is None or
@@ -396,7 +471,7 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
                 return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
             return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
         said = _negated(rhs, r) if isinstance(rhs, Not) else None
-        return r.pick("invariant", used, a=sub(lhs), b=said or sub(rhs))
+        return r.pick("invariant", used, allow=_only(lhs), a=sub(lhs), b=said or sub(rhs))
     steps = _sequence(f)
     if steps is not None and len(steps) == 2:
         return r.pick("sequence", used, a=sub(steps[0]), b=sub(steps[1]))
@@ -410,6 +485,38 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None) -> str | None:
     if isinstance(f, Until) and f.interval is None and isinstance(f.lhs, Not):
         return r.pick("avoid_until", used, a=sub(f.lhs.arg), b=sub(f.rhs))
     return None
+
+
+def _patrol(f: Formula, r: Realizer) -> tuple[str, str] | None:
+    """The two places of ``G(F(a)) & G(F(b))`` over places, in half the sampled
+    sentences where both have one, else ``None``."""
+    if r.rng is None or not (isinstance(f, And) and len(f.args) == 2):
+        return None
+    found = [_untimed(_untimed(g, Always), Eventually) for g in f.args]
+    if any(not isinstance(g, Atom) for g in found) or found[0] == found[1]:
+        return None
+    places = [r.say_place(g.name) for g in found]
+    if None in places or r.rng.random() >= 0.5:
+        return None
+    return places[0], places[1]
+
+
+def _choice(f: Formula, r: Realizer, used: list[str] | None, now: bool) -> str:
+    """One side of "a or b, but not both": a command said bare, as a list of
+    alternatives has it ("pick up the blue block or the green one"), not "please ..."."""
+    arg = _untimed(f, Eventually)
+    if now and isinstance(arg, Atom) and r.is_action(arg.name):
+        return r.pick("F_do", used, allow=lambda p: p in _BARE_DO, a=r.say_atom(arg.name))
+    return _say(f, r, used, embedded=True, now=now, plain=False)
+
+
+def _is_xor(f: Formula) -> bool:
+    """Whether ``f`` is ``(a | b) & !(a & b)``: exactly one of two."""
+    if not (isinstance(f, And) and len(f.args) == 2):
+        return False
+    either, neither = f.args
+    return (isinstance(either, Or) and len(either.args) == 2 and isinstance(neither, Not)
+            and isinstance(neither.arg, And) and neither.arg.args == either.args)
 
 
 def _visits(f: Formula) -> list[Formula] | None:

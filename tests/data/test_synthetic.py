@@ -84,6 +84,18 @@ def test_three_step_sequences_and_visits_in_any_order_are_drawn(train_records):
     assert any("in that order" in r.nl for r in train_records)
 
 
+def test_patrols_settling_and_exactly_one_of_two_are_drawn(train_records):
+    """Tests the patterns 3.3.0 added, each with its idiom in some wording: a place
+    reached for good, or again and again, is said as a place."""
+    said = " | ".join(r.nl.lower() for r in train_records)
+    for idiom in ("stay there", "keep coming back to", "patrol between", "from then on",
+                  "but not both", " only when "):
+        assert idiom in said, idiom
+    settled = [r for r in train_records if r.form == "grounded"
+               and re.fullmatch(r"F\(G\((at|in)_\w+\)\)", r.stl)]
+    assert settled and any("there" in r.nl for r in settled)
+
+
 def test_lifted_and_grounded_records_of_a_row_share_their_shape(train_records):
     """Tests that a row's two records say the same formula over different names."""
     rows = {}
@@ -150,7 +162,7 @@ def test_an_action_may_trigger_a_response_said_as_an_event(train_records):
         verb, _, thing = r.formula.arg.lhs.name.partition("_")
         # never "you red box" for pick_red_box; a lone verb's event is "you report"
         assert not thing or f"you {thing.replace('_', ' ')}" not in r.nl
-        assert re.search(r"\b(you|is|are) ", r.nl), r.nl
+        assert re.search(r"\b(you|is|are|sounds) ", r.nl), r.nl
 
 
 def test_roles_of_a_response_with_an_action_trigger():

@@ -31,6 +31,9 @@ from conftest import formulas
         ("F(a) & b", "eventually a, and b"),
         ("(a | b) -> F(c)", "if either a or b, then eventually c"),
         ("F(pick & F(place)) & G(!obstacle)", "first pick, then place, and never obstacle"),
+        ("F(a & G(b))", "eventually a, and from then on always b"),
+        ("(a | b) & !(a & b)", "a or b, but not both"),
+        ("(F(a) | F(b)) & !(F(a) & F(b))", "eventually a or eventually b, but not both"),
     ],
 )
 def test_explain_reads_idioms_and_scope(formula, english):
@@ -159,3 +162,48 @@ def test_a_place_left_alone_has_its_own_words():
     # "stay out of" lasts: never for a single instant without G
     once = {realize(parse("F(!in_kitchen)"), realizer).lower() for _ in range(100)}
     assert not [s for s in once if "stay out" in s]
+
+
+def _sayings(formula: str, seeds: int = 200, **words) -> set[str]:
+    f = parse(formula)
+    return {realize(f, Realizer(rng=random.Random(seed), mode="train", **words))
+            .rstrip(".").lower() for seed in range(seeds)}
+
+
+def test_a_place_is_reached_for_good_or_again_and_again():
+    """Tests the idioms over places: F(G(a)) "go to a and stay there", G(F(a)) "keep
+    coming back to a", G(F(a)) & G(F(b)) "patrol between a and b"; a proposition that
+    is no place keeps the compositional words."""
+    places = {"at_dock": "the dock", "in_lab": "the lab"}
+    words = {"say_atom": {"at_dock": "stay at the dock", "in_lab": "you are in the lab",
+                          "door": "the door is open"}.__getitem__,
+             "say_place": places.get}
+    assert "go to the dock and stay there" in _sayings("F(G(at_dock))", **words)
+    assert "keep coming back to the dock" in _sayings("G(F(at_dock))", **words)
+    patrol = _sayings("G(F(at_dock)) & G(F(in_lab))", **words)
+    assert "patrol between the dock and the lab" in patrol
+    assert not [s for s in _sayings("F(G(door))", **words) if "there" in s]
+    # The words are the first instant's: a bound or a nested G keeps them out
+    assert not [s for s in _sayings("F[0,5](G(at_dock))", **words) if "stay there" in s]
+    assert explain(parse("F(G(at_dock))")) == "eventually at_dock forever"
+
+
+def test_only_if_and_only_when_follow_a_single_proposition():
+    """Tests "a only if b" for a -> b and "a only when b" for G(a -> b), said only when
+    a is a proposition: "p or q only if b" would read as binding q alone."""
+    assert "a only if b" in _sayings("a -> b")
+    assert {"a only when b", "a only while b"} <= _sayings("G(a -> b)")
+    compound = _sayings("G((a | c) -> b)") | _sayings("(a | c) -> b")
+    assert not [s for s in compound if " only " in s.replace("and only", "")]
+
+
+def test_exactly_one_of_two_goals_says_each_goal_as_a_bare_command():
+    """Tests "pick up the blue block or the green block, but not both": the goals of
+    a choice are commands, without "please" or "you have to" in the middle."""
+    words = {"say_atom": {"pick_blue": "pick up the blue block",
+                          "pick_green": "pick up the green block"}.__getitem__,
+             "is_action": lambda name: True}
+    said = _sayings("(F(pick_blue) | F(pick_green)) & !(F(pick_blue) & F(pick_green))",
+                    **words)
+    assert "pick up the blue block or pick up the green block, but not both" in said
+    assert not [s for s in said if "please" in s or "have to" in s]
