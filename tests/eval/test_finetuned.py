@@ -29,7 +29,7 @@ def finetuned(embedded_model_path):
 
 
 @pytest.mark.parametrize(("adapter", "version"), [
-    (FINETUNED_LORA, "6c3132045205"),  # the compositional mixture of generator 3.1.0
+    (FINETUNED_LORA, "690d5d4a1e5f"),  # the compositional mixture of generator 3.2.0
     (PAPER_LORA, "1de1d813ead6"),  # the registered paper split
 ])
 def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
