@@ -393,9 +393,15 @@ def _negated(f: Not, r: Realizer) -> str | None:
     sentences where there is one. Said only where ``!name`` holds throughout (under
     ``G``, or what an invariant asks for): "eventually stay out of the kitchen" would
     read as F(G(!in_kitchen)), not F(!in_kitchen)."""
-    if r.rng is None or not isinstance(f.arg, Atom):
+    return _sometimes(f.arg, r.say_negated, r)
+
+
+def _sometimes(f: Formula, say: Callable[[str], str | None], r: Realizer) -> str | None:
+    """``say``'s words for the proposition ``f``, in half the sampled sentences where
+    it has some, else ``None``."""
+    if r.rng is None or not isinstance(f, Atom):
         return None
-    said = r.say_negated(f.arg.name)
+    said = say(f.name)
     return said if said is not None and r.rng.random() < 0.5 else None
 
 
@@ -409,15 +415,6 @@ def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | No
     if interval.lo == 0:
         return r.pick(op + "_n", used, n=interval.hi, **slots)
     return r.pick(op + "_ab", used, lo=interval.lo, hi=interval.hi, **slots)
-
-
-def _place(f: Formula, r: Realizer) -> str | None:
-    """The place ``f`` is about, if it is a proposition with one, in half the sampled
-    sentences."""
-    if r.rng is None or not isinstance(f, Atom):
-        return None
-    said = r.say_place(f.name)
-    return said if said is not None and r.rng.random() < 0.5 else None
 
 
 def _untimed(f: Formula, op: type) -> Formula | None:
@@ -437,18 +434,14 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         if negated is not None:  # "always stay out of the kitchen"
             return _timed("G", f.interval, r, used, a=negated)
         return _timed("never", f.interval, r, used, a=sub(f.arg.arg))
-    inner = _untimed(f, Eventually)
-    if inner is not None and _untimed(inner, Always) is not None:
-        place = _place(inner.arg, r)
-        if place is not None:  # "go to the charging station and stay there"
-            return r.pick("FG_place", used, x=place)
-        return r.pick("FG", used, a=sub(inner.arg))
-    inner = _untimed(f, Always)
-    if inner is not None and _untimed(inner, Eventually) is not None:
-        place = _place(inner.arg, r)
-        if place is not None:  # "keep coming back to the charging station"
-            return r.pick("GF_place", used, x=place)
-        return r.pick("GF", used, a=sub(inner.arg))
+    for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
+        inner = _untimed(f, outer)
+        if inner is not None and _untimed(inner, nested) is not None:
+            # "go to the dock and stay there", "keep coming back to the dock"
+            place = _sometimes(inner.arg, r.say_place, r)
+            if place is not None:
+                return r.pick(key + "_place", used, x=place)
+            return r.pick(key, used, a=sub(inner.arg))
     patrol = _patrol(f, r)
     if patrol is not None:
         return r.pick("GF2_place", used, x=patrol[0], y=patrol[1])
