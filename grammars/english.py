@@ -11,7 +11,8 @@ often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, t
 b", ``(a | b) & !(a & b)`` "a or b, but not both"; in sampled sentences also ``F(a) &
 F(b)`` "a and b, in any order", ``G(a -> F(b))`` with ``b`` a command "whenever a, b",
 and over places ``F(G(a))`` "go to a and stay there", ``G(F(a))`` "keep coming back to
-a", ``G(F(a)) & G(F(b))`` "patrol between a and b". Everything else
+a", ``G(F(a)) & G(F(b))`` "patrol between a and b"; and ``G(a -> !b)`` with ``b``
+an action "never b while a". Everything else
 is read compositionally, and a binary subformula under another operator is read in its
 bracketing form ("both ... and ...", "either ... or ...") so that the scope survives in
 the sentence.
@@ -123,6 +124,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
                    "every time {a}, {b} within the next {n} {u}",
                    "each time {a}, {b} in at most {n} {u}",
                    "whenever {a}, within {n} {u} {b}"),
+    # G(a -> !b) with b an action: what is forbidden while a holds.
+    "invariant_not": ("never {b} while {a}", "do not {b} while {a}", "never {b} when {a}",
+                      "you must not {b} while {a}", "{b} is not allowed while {a}",
+                      "whenever {a}, never {b}"),
     "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
                   "at all times, if {a} then {b}", "always, if {a}, then {b}",
                   "while {a}, {b}", "{b} while {a}", "as long as {a}, {b}",
@@ -191,6 +196,7 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "response_do": frozenset({"{b} every time {a}"}),
     "response_n": frozenset({"whenever {a}, within {n} {u} {b}"}),
     "invariant": frozenset({"always, if {a}, then {b}"}),
+    "invariant_not": frozenset({"{b} is not allowed while {a}"}),
     "sequence": frozenset({"{a}, followed by {b}"}),
     "sequence3": frozenset({"in this order: {a}, {b}, {c}"}),
     "visit_any": frozenset({"{l}, the order does not matter"}),
@@ -458,12 +464,16 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
                                              (rhs.interval.lo == 0 and rhs.interval.hi)):
             command = isinstance(rhs.arg, Atom) and r.is_action(rhs.arg.name) \
                 and not r.is_lasting(rhs.arg.name)
-            if rhs.interval is None and command and r.rng is not None and r.rng.random() < 0.5:
+            if rhs.interval is None and command and r.rng is not None and r.rng.random() < 0.7:
                 return r.pick("response_do", used, a=sub(lhs), b=sub(rhs.arg))
             if rhs.interval is None:
                 return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
             return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
         said = _negated(rhs, r) if isinstance(rhs, Not) else None
+        if said is None and isinstance(rhs, Not) and isinstance(rhs.arg, Atom) \
+                and r.is_action(rhs.arg.name) and r.rng is not None and r.rng.random() < 0.5:
+            # "never touch the pan while the stove is on"
+            return r.pick("invariant_not", used, a=sub(lhs), b=sub(rhs.arg))
         return r.pick("invariant", used, allow=_only(lhs), a=sub(lhs), b=said or sub(rhs))
     steps = _sequence(f)
     if steps is not None and len(steps) == 2:

@@ -142,7 +142,11 @@ def test_grounded_rows_say_a_triggered_proposition_as_a_condition(train_records)
     assert not [name for name in lhs if name.startswith(ACTION_PREFIXES)
                 and name not in triggers]
     achievements = tuple(p for p in ACTION_PREFIXES if p not in LASTING_PREFIXES)
-    assert not [name for name in rhs if name.startswith(achievements)]
+    # ...except what an invariant forbids: "never pick up the box while the alarm is on"
+    forbidden = {n.rhs.arg.name for n in implications
+                 if isinstance(n.rhs, Not) and isinstance(n.rhs.arg, Atom)}
+    assert not [name for name in rhs if name.startswith(achievements)
+                and name not in forbidden]
     assert [name for name in rhs if name.startswith(LASTING_PREFIXES)]
     # The response to a command is said the way users say it
     assert any(r.nl.lower().startswith(("whenever", "every time")) and "eventually"
@@ -172,6 +176,23 @@ def test_roles_of_a_response_with_an_action_trigger():
     assert roles.conditions == {"c", "e", "f"} and roles.states == {"g"}
     # A proposition said elsewhere too keeps one wording: a condition there
     assert roles_of(parse("G(a -> F(b)) & F(a)")).triggers == frozenset()
+
+
+def test_an_invariant_may_forbid_any_action(train_records):
+    """Tests that G(c -> !b) is taught with achievements as b, said "never b while c"
+    ("never pick up the red box while the alarm is on"), and that b stays a state
+    where it occurs elsewhere too."""
+    achievements = tuple(p for p in ACTION_PREFIXES if p not in LASTING_PREFIXES)
+    forbidding = [r for r in train_records if r.form == "grounded"
+                  and isinstance(r.formula, Always) and isinstance(r.formula.arg, Implies)
+                  and isinstance(r.formula.arg.rhs, Not)
+                  and isinstance(r.formula.arg.rhs.arg, Atom)
+                  and r.formula.arg.rhs.arg.name.startswith(achievements)]
+    assert forbidding
+    assert [r for r in forbidding if re.search(r"\b(never|do not|must not) .* (while|when) ",
+                                               r.nl.lower())]
+    assert roles_of(parse("G(a -> !b)")).states == frozenset()
+    assert roles_of(parse("G(a -> !b) & F(b)")).states == {"b"}
 
 
 def test_held_out_shapes_stay_on_the_test_side(train_records):

@@ -207,3 +207,18 @@ def test_exactly_one_of_two_goals_says_each_goal_as_a_bare_command():
                     **words)
     assert "pick up the blue block or pick up the green block, but not both" in said
     assert not [s for s in said if "please" in s or "have to" in s]
+
+
+def test_what_an_action_may_not_do_while_a_condition_holds():
+    """Tests "never touch the pan while the stove is on" for G(stove_on -> !touch_pan):
+    said of actions only, since "never the door is open while ..." is no sentence."""
+    words = {"say_atom": {"stove_on": "the stove is on", "touch_pan": "touch the pan",
+                          "door_open": "the door is open"}.__getitem__,
+             "is_action": lambda name: name == "touch_pan"}
+    said = _sayings("G(stove_on -> !touch_pan)", **words)
+    assert {"never touch the pan while the stove is on",
+            "do not touch the pan while the stove is on"} <= said
+    assert "whenever the stove is on, do not touch the pan" in said  # the old words stay
+    assert not [s for s in _sayings("G(stove_on -> !door_open)", **words)
+                if s.startswith("never the door")]
+    assert explain(parse("G(a -> !b)")) == "whenever a, not b"
