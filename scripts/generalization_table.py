@@ -64,7 +64,7 @@ MODELS = {
     "compositional-adapter-v14-270m": ("compositional adapter v14 (v13 trained on, on 3.4.0)",
                                        ("compositional", "aaa2649e1656")),
     "soup-v13v14-270m": ("soup v13+v14", ("compositional", "aaa2649e1656")),
-    "soup-v11v12v13-270m": ("soup v11+v12+v13", ("compositional", "9c33668eac7c")),
+    "soup-v11v12v13-270m": ("soup v11+v12+v13 (not shipped)", ("compositional", "9c33668eac7c")),
     "soup-v7v8-270m": ("soup v7+v8 (shipped until 2026-11-23)",
                        ("compositional", "6c3132045205")),
     "soup-v7v8v10-270m": ("soup v7+v8+v10 (shipped until 2026-11-24)",
