@@ -135,19 +135,26 @@ def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) 
     a, b = leaf(), leaf()
     iv = _maybe_interval(rng, s)
     bounded = iv if iv is not None and iv.lo == 0 else None
+
+    def three_steps() -> Formula:
+        return Eventually(And((a, Eventually(And((b, Eventually(leaf())))))))
+
+    def response() -> Formula:
+        return Always(Implies(a, Eventually(b, bounded)))
+
+    def three_visits() -> Formula:
+        return And((And((Eventually(a), Eventually(b))), Eventually(leaf())))
+
     choices: list[Callable[[], Formula]] = [
         lambda: Eventually(a, iv), lambda: Always(a, iv), lambda: Always(Not(a), iv),
         lambda: Eventually(Always(a)), lambda: Always(Eventually(a)),
-        lambda: Eventually(And((a, Eventually(b)))),
-        lambda: Eventually(And((a, Eventually(And((b, Eventually(leaf()))))))),
-        lambda: Always(Implies(a, Eventually(b, bounded))), lambda: Always(Implies(a, b)),
-        lambda: Always(Implies(a, Not(b))),
+        lambda: Eventually(And((a, Eventually(b)))), three_steps, response,
+        lambda: Always(Implies(a, b)), lambda: Always(Implies(a, Not(b))),
         lambda: Until(a, b, iv), lambda: Until(Not(a), b),
         lambda: Implies(a, Eventually(b, iv)), lambda: Eventually(a, iv),
         lambda: Always(Not(a), iv),
         # Visits in any order (Menghi et al.'s "visit" mission pattern)
-        lambda: And((Eventually(a), Eventually(b))),
-        lambda: And((And((Eventually(a), Eventually(b))), Eventually(leaf()))),
+        lambda: And((Eventually(a), Eventually(b))), three_visits,
         # Patrolling (Menghi et al.'s "patrolling"), a moment and what holds from then
         # on, exactly one of two (of two goals half the time)
         lambda: And((Always(Eventually(a)), Always(Eventually(b)))),
@@ -155,10 +162,8 @@ def _pattern(rng: random.Random, s: SynthSettings, leaf: Callable[[], Formula]) 
         lambda: _exactly_one(*((Eventually(a), Eventually(b)) if rng.random() < 0.5
                                else (a, b))),
         # What users ask for most and 3.3's fine-tunes still missed, drawn twice as
-        # often: a response, three steps in order, three visits in any order
-        lambda: Always(Implies(a, Eventually(b, bounded))),
-        lambda: Eventually(And((a, Eventually(And((b, Eventually(leaf()))))))),
-        lambda: And((And((Eventually(a), Eventually(b))), Eventually(leaf()))),
+        # often (the order of the list is part of the mixture's version)
+        response, three_steps, three_visits,
     ]
     return rng.choice(choices)()
 
