@@ -44,7 +44,11 @@ the stove is on", ``G(stove_on -> !touch_pan)``), where any action, an achieveme
 too, may be forbidden; says a response to a command as the bare command ("whenever
 the battery is low, go to the charging station") in 70% of such sentences, not half;
 and draws responses, three-step sequences and visits of three in any order twice as
-often as before.
+often as before. Version 3.5 widens the grounded vocabulary (:mod:`ara.data.vocabulary`):
+devices and what is done to them ("turn off the fan", "close the valve"), more object
+verbs ("load", "scan", "drop") and standalone actions ("slow down"), and conditions whose
+words sound negative ("the lights are off", "the tank is empty"), so that a name with
+"off", "low" or "empty" in it is read as the proposition it is, not as its negation.
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators) and the
@@ -85,7 +89,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.4.0"
+SYNTHETIC_VERSION = "3.5.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.

@@ -28,6 +28,16 @@ OBJECTS = (
     ("yellow_ball", "yellow ball"), ("laptop", "laptop"), ("keys", "keys"), ("mug", "mug"),
 )
 NUMBERED_OBJECTS = (("pallet", "pallet"), ("crate", "crate"), ("bin", "bin"))
+#: Things a robot switches, opens or cleans; their verbs often sound negative ("turn off
+#: the fan", "close the valve") and name a proposition all the same, never its negation.
+DEVICES = (
+    ("fan", "fan"), ("valve", "valve"), ("window", "window"), ("oven", "oven"),
+    ("heater", "heater"), ("pump", "pump"), ("tap", "tap"), ("drawer", "drawer"),
+    ("lid", "lid"), ("hatch", "hatch"), ("printer", "printer"), ("lamp", "lamp"),
+    ("vacuum", "vacuum"), ("cabinet", "cabinet"), ("microwave", "microwave"),
+    ("projector", "projector"), ("washing_machine", "washing machine"),
+)
+NUMBERED_DEVICES = (("machine", "machine"), ("locker", "locker"), ("terminal", "terminal"))
 
 PLACE_VERBS = (
     ("go_to", ("go to the {x}", "go to {x}", "head to the {x}", "move to the {x}",
@@ -45,10 +55,27 @@ OBJECT_VERBS = (
     ("hold", ("hold the {x}", "carry the {x}")),
     ("inspect", ("inspect the {x}", "check the {x}")),
 )
+#: Less common things done to objects, drawn less often than :data:`OBJECT_VERBS`.
+MORE_OBJECT_VERBS = (
+    ("load", ("load the {x}",)), ("unload", ("unload the {x}",)),
+    ("scan", ("scan the {x}",)), ("lift", ("lift the {x}", "raise the {x}")),
+    ("drop", ("drop the {x}", "let go of the {x}")), ("push", ("push the {x}",)),
+    ("sort", ("sort the {x}",)), ("weigh", ("weigh the {x}",)),
+)
+DEVICE_VERBS = (
+    ("turn_on", ("turn on the {x}", "switch on the {x}", "start the {x}")),
+    ("turn_off", ("turn off the {x}", "switch off the {x}", "shut down the {x}")),
+    ("open", ("open the {x}",)), ("close", ("close the {x}", "shut the {x}")),
+    ("clean", ("clean the {x}", "wipe down the {x}")),
+    ("lock", ("lock the {x}",)), ("unlock", ("unlock the {x}",)),
+    ("empty", ("empty the {x}",)), ("repair", ("repair the {x}", "fix the {x}")),
+)
 STANDALONE_ACTIONS = (
     ("charge", ("charge", "recharge the battery")), ("wait", ("wait", "stay still")),
     ("beep", ("beep", "sound the horn")), ("report", ("report", "send a report")),
     ("stop", ("stop", "halt", "come to a stop")),
+    ("dock", ("dock", "return to base")), ("shut_down", ("shut down", "power off")),
+    ("reverse", ("reverse", "back up")), ("honk", ("honk",)),
 )
 #: Achievements said as something that happens, for the trigger of a response
 #: ("whenever you pick up the red box, ..."): ``G(pick_red_box -> F(...))``.
@@ -65,6 +92,15 @@ EVENTS = {
     "charge": ("you charge", "the battery is recharged"),
     "beep": ("you beep", "the horn sounds"),
     "report": ("you report", "a report is sent"),
+    "turn_on": ("you turn on the {x}", "the {x} is switched on"),
+    "turn_off": ("you turn off the {x}", "the {x} is switched off"),
+    "open": ("you open the {x}", "the {x} is opened"),
+    "close": ("you close the {x}", "the {x} is shut"),
+    "clean": ("you clean the {x}", "the {x} is cleaned"),
+    "load": ("you load the {x}", "the {x} is loaded"),
+    "unload": ("you unload the {x}", "the {x} is unloaded"),
+    "scan": ("you scan the {x}", "the {x} is scanned"),
+    "drop": ("you drop the {x}", "the {x} is dropped"),
 }
 CONDITIONS = (
     ("door_open", ("the door is open",)), ("battery_low", ("the battery is low",
@@ -76,6 +112,17 @@ CONDITIONS = (
     ("gripper_closed", ("the gripper is closed",)), ("task_done", ("the task is done",)),
     ("path_blocked", ("the path is blocked",)), ("floor_wet", ("the floor is wet",)),
     ("human_request", ("a human asks for help", "a person requests help")),
+    # Conditions whose words sound negative name a proposition, not its negation
+    ("lights_off", ("the lights are off",)), ("tank_empty", ("the tank is empty",)),
+    ("signal_lost", ("the signal is lost", "the connection drops")),
+    ("motor_stopped", ("the motor has stopped", "the motor is stopped")),
+    ("power_low", ("power is low", "the power runs low")),
+    ("temperature_high", ("the temperature is high", "it is too hot")),
+    ("window_closed", ("the window is closed",)), ("area_clear", ("the area is clear",)),
+    ("queue_empty", ("the queue is empty", "no orders are waiting")),
+    ("sensor_offline", ("the sensor is offline", "the sensor stops working")),
+    ("arm_idle", ("the arm is idle",)), ("gate_down", ("the gate is down",)),
+    ("snowing", ("it is snowing",)), ("night", ("it is night",)),
 )
 #: Conditions about a place or an object: where the robot is, what it holds.
 PLACE_STATES = (("in", ("the robot is in the {x}", "you are in the {x}")),
@@ -162,12 +209,15 @@ def _draw_being_at(rng: random.Random) -> Proposition:
 def _draw_event(rng: random.Random) -> Proposition:
     """An achievement said as an event: a clause, so ``action`` is false."""
     kind = rng.random()
-    if kind < 0.45:
+    if kind < 0.4:
         verb = rng.choice([v for v, _ in PLACE_VERBS if v in EVENTS])
         name, words = _thing(rng, PLACES, NUMBERED_PLACES)
-    elif kind < 0.9:
-        verb = rng.choice([v for v, _ in OBJECT_VERBS if v in EVENTS])
+    elif kind < 0.75:
+        verb = rng.choice([v for v, _ in OBJECT_VERBS + MORE_OBJECT_VERBS if v in EVENTS])
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    elif kind < 0.9:
+        verb = rng.choice([v for v, _ in DEVICE_VERBS if v in EVENTS])
+        name, words = _thing(rng, DEVICES, NUMBERED_DEVICES)
     else:
         verb = rng.choice([v for v, _ in STANDALONE_ACTIONS if v in EVENTS])
         return Proposition(verb, EVENTS[verb], action=False)
@@ -190,12 +240,15 @@ def _draw_condition(rng: random.Random) -> Proposition:
 
 def _draw_one(rng: random.Random) -> Proposition:
     kind = rng.random()
-    if kind < 0.45:
+    if kind < 0.4:
         verb, phrases = rng.choice(PLACE_VERBS)
         name, words = _thing(rng, PLACES, NUMBERED_PLACES)
-    elif kind < 0.8:
-        verb, phrases = rng.choice(OBJECT_VERBS)
+    elif kind < 0.7:
+        verb, phrases = rng.choice(OBJECT_VERBS if kind < 0.62 else MORE_OBJECT_VERBS)
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    elif kind < 0.8:
+        verb, phrases = rng.choice(DEVICE_VERBS)
+        name, words = _thing(rng, DEVICES, NUMBERED_DEVICES)
     elif kind < 0.86:
         verb, phrases = rng.choice(STANDALONE_ACTIONS)
         return Proposition(verb, phrases, action=True, lasting=verb in LASTING_VERBS)

@@ -17,6 +17,13 @@ from ara.data.synthetic import (
     shape,
     synthetic_records,
 )
+from ara.data.vocabulary import (
+    DEVICE_VERBS,
+    MORE_OBJECT_VERBS,
+    OBJECT_VERBS,
+    PLACE_VERBS,
+    STANDALONE_ACTIONS,
+)
 from ara.errors import ConfigError
 from ara.grammars import Syntax, parse
 from ara.grammars.ast import (
@@ -105,9 +112,8 @@ def test_lifted_and_grounded_records_of_a_row_share_their_shape(train_records):
         assert shape(pair["lifted"].formula) == shape(pair["grounded"].formula)
 
 
-ACTION_PREFIXES = ("go_to_", "visit_", "reach_", "enter_", "leave_", "at_", "pick_",
-                   "place_", "deliver_", "hold_", "inspect_", "charge", "wait", "beep",
-                   "report")
+ACTION_PREFIXES = (tuple(f"{verb}_" for verb, _ in PLACE_VERBS + OBJECT_VERBS + MORE_OBJECT_VERBS
+                         + DEVICE_VERBS) + tuple(verb for verb, _ in STANDALONE_ACTIONS))
 
 
 def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
@@ -120,7 +126,7 @@ def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
     assert not [name for name in read_now if name.startswith(ACTION_PREFIXES)]
 
 
-LASTING_PREFIXES = ("at_", "hold_", "wait")
+LASTING_PREFIXES = ("at_", "hold_", "wait", "stop")
 
 
 def test_grounded_rows_say_a_triggered_proposition_as_a_condition(train_records):
@@ -193,6 +199,27 @@ def test_an_invariant_may_forbid_any_action(train_records):
                                                r.nl.lower())]
     assert roles_of(parse("G(a -> !b)")).states == frozenset()
     assert roles_of(parse("G(a -> !b) & F(b)")).states == {"b"}
+
+
+def test_names_that_sound_negative_are_propositions_not_negations(train_records):
+    """Tests that "turn off the fan" is taught as turn_off_fan and "the lights are off"
+    as lights_off, unnegated: a fine-tune that had seen no such name wrote
+    F(!turn_off_stove) for "turn off the stove"."""
+    negative = {"off", "close", "shut", "empty", "low", "lost", "stopped", "down", "closed"}
+    # "no orders are waiting" is queue_empty, "the connection drops" signal_lost
+    negative_words = re.compile(rf"\b({'|'.join(negative | {'no', 'drops'})})\b")
+    said_plainly = []
+    for r in train_records:
+        if r.form != "grounded":
+            continue
+        negated = {n.arg.name for n in walk(r.formula)
+                   if isinstance(n, Not) and isinstance(n.arg, Atom)}
+        plain = [n.name for n in walk(r.formula) if isinstance(n, Atom)
+                 and n.name not in negated and negative & set(n.name.split("_"))]
+        if plain:
+            said_plainly.append(r)
+            assert negative_words.search(r.nl.lower()), r.nl
+    assert len(said_plainly) >= 20
 
 
 def test_held_out_shapes_stay_on_the_test_side(train_records):
