@@ -46,7 +46,7 @@ the battery is low, go to the charging station") in 70% of such sentences, not h
 and draws responses, three-step sequences and visits of three in any order twice as
 often as before. Version 3.5 widens the grounded vocabulary (:mod:`ara.data.vocabulary`):
 devices and what is done to them ("turn off the fan", "close the valve"), more object
-verbs ("load", "scan", "drop") and standalone actions ("slow down"), and conditions whose
+verbs ("load", "scan", "drop") and standalone actions ("return to base"), and conditions whose
 words sound negative ("the lights are off", "the tank is empty"), so that a name with
 "off", "low" or "empty" in it is read as the proposition it is, not as its negation.
 

@@ -19,6 +19,7 @@ from ara.data.synthetic import (
 )
 from ara.data.vocabulary import (
     DEVICE_VERBS,
+    LASTING_VERBS,
     MORE_OBJECT_VERBS,
     OBJECT_VERBS,
     PLACE_VERBS,
@@ -112,8 +113,17 @@ def test_lifted_and_grounded_records_of_a_row_share_their_shape(train_records):
         assert shape(pair["lifted"].formula) == shape(pair["grounded"].formula)
 
 
-ACTION_PREFIXES = (tuple(f"{verb}_" for verb, _ in PLACE_VERBS + OBJECT_VERBS + MORE_OBJECT_VERBS
-                         + DEVICE_VERBS) + tuple(verb for verb, _ in STANDALONE_ACTIONS))
+STANDALONE = {verb for verb, _ in STANDALONE_ACTIONS}
+
+
+def name_prefixes(verbs) -> tuple[str, ...]:
+    """How names made from ``verbs`` begin: ``pick_red_box``, but a lone ``wait``."""
+    return tuple(verb if verb in STANDALONE else f"{verb}_" for verb in verbs)
+
+
+ACTION_PREFIXES = name_prefixes(
+    [verb for verb, _ in PLACE_VERBS + OBJECT_VERBS + MORE_OBJECT_VERBS + DEVICE_VERBS]
+    + sorted(STANDALONE))
 
 
 def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
@@ -126,7 +136,7 @@ def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
     assert not [name for name in read_now if name.startswith(ACTION_PREFIXES)]
 
 
-LASTING_PREFIXES = ("at_", "hold_", "wait", "stop")
+LASTING_PREFIXES = name_prefixes(sorted(LASTING_VERBS))
 
 
 def test_grounded_rows_say_a_triggered_proposition_as_a_condition(train_records):
