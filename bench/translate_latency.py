@@ -1,7 +1,7 @@
 """Latency of `ara translate` as users get it, before and after the compositional
 fine-tune, measured side by side in one run on the same sentences.
 
-    .venv/bin/python bench/translate_latency.py [--n 40]
+    .venv/bin/python bench/translate_latency.py [--n 40] [--candidate lora:FILE.gguf ...]
 
 Rows: the earlier default (paper-split adapter, grammar without time bounds), the new
 default (compositional adapter; intervals use 0 and the numbers the sentence writes),
@@ -9,6 +9,8 @@ the same adapter with any bound up to 1000 (a grammar of two rules per number, w
 llguidance compiles for every new set of propositions), and without time bounds. Zero-shot, greedy,
 under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one warm-up
 call first. A formula's time depends on its length, so tokens per answer are shown too.
+Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
+with the default grammar, so a candidate is timed beside what ships, in the same run.
 """
 
 from __future__ import annotations
@@ -35,6 +37,9 @@ def measure(translator: Translator, records) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=40, help="hand-written instructions")
+    ap.add_argument("--candidate", action="append", default=[], metavar="MODEL",
+                    help="another --model value to time with the default grammar "
+                         "(repeatable), e.g. lora:runs/soup/x/lora.gguf")
     args = ap.parse_args()
     records = random.Random(0).sample(load_or_prepare("handwritten").records("test", "grounded"),
                                       args.n)
@@ -48,7 +53,9 @@ def main() -> None:
             ("finetuned", TranslatorConfig(), "default", "bounds the sentence writes"),
             ("finetuned", TranslatorConfig(bounds_from_request=False), "--any-bound",
              "any bound up to 1000"),
-            ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds")]
+            ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds"),
+            *[(model, TranslatorConfig(), "candidate", "bounds the sentence writes")
+              for model in args.candidate]]
     base = None
     for model, config, label, grammar in rows:
         t = Translator(make_backend(model), config)

@@ -48,6 +48,11 @@ def soup_cmd(
     weights: list[float] = typer.Option(
         None, "--weight", help="One weight per --run, in order (default: all equal)."),
     out: Path = typer.Option(..., "--out", help="The soup's run folder (adapter/, run.json)."),
+    rank: int = typer.Option(
+        None, "--rank", min=1,
+        help="Truncate the result to this rank by SVD (the parts' ranks add up, and a "
+             "higher rank is slower at every token). With --rank, one --run is enough: "
+             "that run's adapter, reduced."),
 ) -> None:
     """Average the adapters of runs that grew from one start into one exact LoRA adapter.
 
@@ -57,23 +62,31 @@ def soup_cmd(
     import json
 
     from ara.errors import ConfigError
-    from ara.training.soup import SoupPart, average_adapters
+    from ara.training.soup import SoupPart, average_adapters, reduce_rank
 
     with user_errors():
         weights = weights or [1.0] * len(runs)
         if len(weights) != len(runs):
             raise ConfigError(f"{len(weights)} --weight values for {len(runs)} --run folders")
+        if len(runs) < 2 and rank is None:
+            raise ConfigError("a soup needs at least two --run folders (or one and --rank)")
         for run in runs:
             if not (run / "run.json").is_file():
                 raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")
-        parts = [SoupPart(run / "adapter", w) for run, w in zip(runs, weights, strict=True)]
-        soup = average_adapters(parts, out / "adapter")
         # The first run's record (base model, data version) is what export needs; the
         # soup's own parts say where the weights came from.
         record = json.loads((runs[0] / "run.json").read_text())
-        record["soup"] = soup
+        adapter = out / "adapter"
+        if len(runs) > 1:
+            parts = [SoupPart(run / "adapter", w) for run, w in zip(runs, weights, strict=True)]
+            record["soup"] = average_adapters(parts, adapter)
+        if rank is not None:
+            record["reduced"] = reduce_rank(adapter if len(runs) > 1 else runs[0] / "adapter",
+                                            rank, adapter)
+        out.mkdir(parents=True, exist_ok=True)
         (out / "run.json").write_text(json.dumps(record, indent=2) + "\n")
-    typer.echo(json.dumps(record["soup"], indent=2))
+    typer.echo(json.dumps({k: record[k] for k in ("soup", "reduced") if k in record},
+                          indent=2))
 
 
 def export_cmd(

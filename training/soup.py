@@ -13,6 +13,12 @@ stack the ``A`` factors and place each weighted ``B`` beside the others,
 with ``s_i = alpha_i / r_i`` each adapter's scaling and ``s`` the result's. The result is
 exact, loads in PEFT and converts to a GGUF LoRA like any adapter (a rank-16 pair
 becomes rank 32, about twice the file).
+
+The summed rank costs time at every token (llama.cpp applies a LoRA unmerged), so
+:func:`reduce_rank` brings an adapter back to a smaller rank: each module's update
+``s B A`` is replaced by its best rank-``k`` approximation (Eckart-Young: the truncated
+SVD), computed from the thin factors without forming the full matrix. What is dropped
+is reported as the share of each update's squared norm kept.
 """
 
 from __future__ import annotations
@@ -109,4 +115,62 @@ def average_adapters(parts: list[SoupPart], out: Path) -> dict:
     record = {"parts": [{"adapter": str(p.adapter), "weight": p.weight / total} for p in parts],
               "rank": rank, "lora_alpha": alpha}
     (out / "soup.json").write_text(json.dumps(record, indent=2) + "\n")
+    return record
+
+
+def _truncated_factors(b, a, rank: int):
+    """``(B', A', kept)``: the best rank-``rank`` factors of ``B @ A`` and the share of its
+    squared Frobenius norm they keep. Works on the thin QR factors, so the cost follows
+    the adapter's rank, not the module's size."""
+    import torch
+
+    q_b, r_b = torch.linalg.qr(b)          # B = Q_b R_b
+    q_a, r_a = torch.linalg.qr(a.T)        # A = R_a^T Q_a^T
+    u, sigma, vh = torch.linalg.svd(r_b @ r_a.T)
+    root = sigma[:rank].sqrt()
+    total = float((sigma ** 2).sum())
+    kept = float((sigma[:rank] ** 2).sum()) / total if total > 0 else 1.0
+    return (q_b @ u[:, :rank]) * root, root[:, None] * (vh[:rank] @ q_a.T), kept
+
+
+def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
+    """Write to ``out`` the rank-``rank`` adapter nearest ``adapter`` (each module's update
+    truncated by SVD, the scaling ``alpha / r`` kept).
+
+    Returns its record (rank, the rank it came from, the share of the updates' squared
+    norm kept: the least over modules and the mean), also written to ``reduced.json``.
+    """
+    import torch
+    from safetensors.torch import save_file
+
+    config, weights = _load(adapter)
+    if not isinstance(rank, int) or not 1 <= rank <= config["r"]:
+        raise ConfigError(f"a reduced rank must be between 1 and the adapter's rank "
+                          f"{config['r']}, got {rank}")
+    rslora = config.get("use_rslora")
+    scaling = config["lora_alpha"] / (math.sqrt(config["r"]) if rslora else config["r"])
+    reduced: dict[str, torch.Tensor] = {}
+    kept: list[float] = []
+    for key, tensor in weights.items():
+        if ".lora_A." in key:
+            continue
+        if ".lora_B." not in key:
+            raise ConfigError(f"{adapter}: tensor {key} is not a LoRA factor")
+        key_a = key.replace(".lora_B.", ".lora_A.")
+        b, a, share = _truncated_factors(tensor.float(), weights[key_a].float(), rank)
+        reduced[key] = b.to(tensor.dtype).contiguous()
+        reduced[key_a] = a.to(weights[key_a].dtype).contiguous()
+        kept.append(share)
+    out.mkdir(parents=True, exist_ok=True)
+    save_file(reduced, str(out / WEIGHTS))
+    alpha = scaling * (math.sqrt(rank) if rslora else rank)
+    (out / CONFIG).write_text(json.dumps(dict(config, r=rank, lora_alpha=alpha), indent=2)
+                              + "\n")
+    for extra in ("tokenizer.json", "tokenizer_config.json", "soup.json"):
+        if (adapter / extra).is_file() and adapter.resolve() != out.resolve():
+            shutil.copy2(adapter / extra, out / extra)
+    record = {"rank": rank, "from_rank": config["r"], "lora_alpha": alpha,
+              "norm_kept": {"least": round(min(kept), 6),
+                            "mean": round(sum(kept) / len(kept), 6)}}
+    (out / "reduced.json").write_text(json.dumps(record, indent=2) + "\n")
     return record

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from ara.errors import ConfigError
-from ara.training.soup import SoupPart, average_adapters
+from ara.training.soup import SoupPart, average_adapters, reduce_rank
 
 torch = pytest.importorskip("torch")
 peft = pytest.importorskip("peft")
@@ -59,6 +59,38 @@ def test_the_soup_adds_the_updates_of_its_parts_in_proportion(tmp_path):
     assert record == json.loads((soup / "soup.json").read_text())
 
 
+def best_rank(update, k):
+    """The nearest rank-k matrix to ``update`` (Eckart-Young), from the full SVD."""
+    u, sigma, vh = torch.linalg.svd(update.double())
+    return (u[:, :k] * sigma[:k]) @ vh[:k]
+
+
+def test_a_reduced_adapter_is_each_update_truncated_to_its_largest_singular_values(tmp_path):
+    soup = tmp_path / "soup"
+    average_adapters([SoupPart(adapter(tmp_path / "a", seed=1, r=4, alpha=8)),
+                      SoupPart(adapter(tmp_path / "b", seed=2, r=4, alpha=8))], soup)
+    full = updates(soup)
+
+    record = reduce_rank(soup, 3, tmp_path / "r3")
+    config = json.loads((tmp_path / "r3" / "adapter_config.json").read_text())
+    assert config["r"] == 3 and config["lora_alpha"] / config["r"] == 2.0   # scaling kept
+    kept = []
+    for name, update in updates(tmp_path / "r3").items():
+        torch.testing.assert_close(update.double(), best_rank(full[name], 3),
+                                   rtol=1e-4, atol=1e-5)
+        kept.append(float(update.norm() ** 2 / full[name].norm() ** 2))
+    assert record["from_rank"] == 8 and record["rank"] == 3
+    assert record["norm_kept"]["least"] == pytest.approx(min(kept), abs=1e-4)
+    assert 0 < record["norm_kept"]["least"] < 1
+
+    # At the adapter's own rank nothing is lost: the same updates, in other factors.
+    assert reduce_rank(soup, 8, tmp_path / "r8")["norm_kept"]["least"] == pytest.approx(1.0)
+    for name, update in updates(tmp_path / "r8").items():
+        torch.testing.assert_close(update, full[name], rtol=1e-4, atol=1e-5)
+    with pytest.raises(ConfigError, match="between 1 and the adapter's rank 8"):
+        reduce_rank(soup, 9, tmp_path / "r9")
+
+
 def test_adapters_that_cannot_be_averaged_are_refused_by_name(tmp_path):
     a = adapter(tmp_path / "a", seed=1, r=4, alpha=8)
     b = adapter(tmp_path / "b", seed=2, r=4, alpha=8, target_modules=["q_proj"])
@@ -97,3 +129,16 @@ def test_ara_soup_makes_a_run_folder_that_export_can_read(tmp_path):
     bare = CliRunner().invoke(app, ["soup", "--run", str(runs[0]), "--run", str(tmp_path),
                                     "--out", str(tmp_path / "y")])
     assert bare.exit_code != 0 and "no run.json" in bare.output
+
+    # --rank truncates the soup; with it, one run is enough (its adapter, reduced).
+    done = CliRunner().invoke(app, args + ["--rank", "5", "--out", str(tmp_path / "soup5")])
+    assert done.exit_code == 0, done.output
+    record = json.loads((tmp_path / "soup5" / "run.json").read_text())
+    assert record["soup"]["rank"] == 8 and record["reduced"]["rank"] == 5
+    one = ["soup", "--run", str(tmp_path / "soup5"), "--out", str(tmp_path / "soup2")]
+    alone = CliRunner().invoke(app, one)
+    assert alone.exit_code != 0 and "at least two --run folders (or one and --rank)" in alone.output
+    done = CliRunner().invoke(app, one + ["--rank", "2"])
+    assert done.exit_code == 0, done.output
+    record = json.loads((tmp_path / "soup2" / "run.json").read_text())
+    assert record["soup"]["rank"] == 8 and record["reduced"]["from_rank"] == 5
