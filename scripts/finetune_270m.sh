@@ -3,12 +3,14 @@
 # cores (v3 and v4, each fits one session), a 65-min run from v4's adapter on the
 # mixture of generator 3.3.0 (v13), a 75-min run from v13's adapter on generator 3.4.0's
 # (v14), a 70-min run from their mean on generator 3.5.0's (v15), the mean of that mean
-# and v15 (a "soup"), then export, ship and the evaluations (about 45 min).
+# and v15 reduced to rank 16 (a "soup", seconds), a 45-min run from it (v16, shipped),
+# then export, ship and the evaluations (about 45 min).
 #
 #   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 v10 v11 v12 v13
-#                                         v14 v15 soup export ship eval paper disjoint full
-#                                         (default: train continue v13 v14 v15 soup export
-#                                         ship eval)
+#                                         v14 v15 v16 soup export ship eval paper disjoint
+#                                         full
+#                                         (default: train continue v13 v14 v15 soup v16
+#                                         export ship eval)
 #
 # train: v3 (training/configs/gemma3_270m_lora_cpu_compositional.yaml); continue: v4,
 #   400 more steps from v3's adapter (..._compositional_v4.yaml); v6, v7, v8: three more
@@ -21,8 +23,11 @@
 #   adapter on aaa2649e1656 (3.4.0), seed 6, navi's rows x2; v15: 300 steps from the
 #   mean of v13 and v14 (committed as docs/results/training/compositional-270m-soup-v13v14,
 #   made by `ara soup --run ..-v13 --run ..-v14`; shipped until 2026-11-24) on
-#   89be643cc979 (3.5.0), seed 8; soup: the mean of that mean and v15 (`ara soup`, from
-#   the adapters committed under docs/results/training/); export/ship: the soup becomes
+#   89be643cc979 (3.5.0), seed 8; soup: the mean of that mean and v15, reduced to rank
+#   16 by SVD (`ara soup --rank 16`, from the adapters committed under
+#   docs/results/training/; shipped at rank 64 until 2026-11-24; committed as
+#   compositional-270m-soup-v13v14v15-r16); v16: 300 steps from that soup on
+#   89be643cc979, seed 9, the help requests counted twice; export/ship: v16 becomes
 #   `--model finetuned`. A mixture that is no longer
 #   registered (v6 to v13's) is prepared with the release that registered it
 #   (`git log -p data/versions.json`).
@@ -35,16 +40,17 @@
 # Each step can be rerun alone; training resumes from its newest checkpoint and the
 # evaluations from their finished samples. The v5 to v8 configs start from the adapters
 # committed under docs/results/training/ (v4 and v6), so v6 to v8 can run without the
-# earlier runs' folders.
+# earlier runs' folders, as v15 and v16 can.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=.venv/bin
 first_run=runs/train/gemma3-270m-lora-compositional
 v4_run=runs/train/gemma3-270m-lora-compositional-v4
-run=runs/train/gemma3-270m-lora-compositional-soup
+soup_run=runs/train/gemma3-270m-lora-compositional-soup
+run=runs/train/gemma3-270m-lora-compositional-v16
 paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
-steps=${*:-train continue v13 v14 v15 soup export ship eval}
+steps=${*:-train continue v13 v14 v15 soup v16 export ship eval}
 
 train() {  # CONFIG RUN_FOLDER
   if [ -f "$2/run.json" ]; then resume=--resume; else resume=; fi
@@ -92,13 +98,13 @@ for step in $steps; do
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
     train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
-  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15)
+  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15|v16)
     train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
       "runs/train/gemma3-270m-lora-compositional-$step" ;;
   soup)
     # The committed records of the parts; a rerun's parts are in runs/train/..-vN
     parts=docs/results/training/compositional-270m
-    $bin/ara soup --run $parts-soup-v13v14 --run $parts-v15 --out "$run" ;;
+    $bin/ara soup --run $parts-soup-v13v14 --run $parts-v15 --rank 16 --out "$soup_run" ;;
   export)
     # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
     $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
@@ -128,7 +134,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 soup export" \
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 soup export" \
        "ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac

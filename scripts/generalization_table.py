@@ -67,7 +67,7 @@ MODELS = {
                          ("compositional", "aaa2649e1656")),
     "compositional-adapter-v15-270m": ("compositional adapter v15 (soup v13+v14 on 3.5.0)",
                                        ("compositional", "89be643cc979")),
-    "soup-v13v14-v15-270m": ("soup (v13+v14)+v15 (as a candidate)",
+    "soup-v13v14-v15-270m": ("soup (v13+v14)+v15 (shipped until 2026-11-24)",
                              ("compositional", "89be643cc979")),
     "soup-shipped-r32-270m": ("soup (v13+v14)+v15 at rank 32 (SVD)",
                               ("compositional", "89be643cc979")),
@@ -84,7 +84,7 @@ MODELS = {
                           ("compositional", "6c3132045205")),
     "soup-v11v12-270m": ("soup v11+v12 (shipped until 2026-11-24)",
                          ("compositional", "690d5d4a1e5f")),
-    "compositional-adapter-270m": ("soup (v13+v14)+v15 (shipped)",
+    "compositional-adapter-270m": ("v16 (shipped)",
                                    ("compositional", "89be643cc979")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
