@@ -126,11 +126,17 @@ def _truncated_factors(b, a, rank: int):
 
     q_b, r_b = torch.linalg.qr(b)          # B = Q_b R_b
     q_a, r_a = torch.linalg.qr(a.T)        # A = R_a^T Q_a^T
-    u, sigma, vh = torch.linalg.svd(r_b @ r_a.T)
+    u, sigma, vh = torch.linalg.svd(r_b @ r_a.T, full_matrices=False)
     root = sigma[:rank].sqrt()
     total = float((sigma ** 2).sum())
     kept = float((sigma[:rank] ** 2).sum()) / total if total > 0 else 1.0
-    return (q_b @ u[:, :rank]) * root, root[:, None] * (vh[:rank] @ q_a.T), kept
+    b_new, a_new = (q_b @ u[:, :rank]) * root, root[:, None] * (vh[:rank] @ q_a.T)
+    # A module narrower than the rank has fewer singular values: the rest are zero.
+    missing = rank - b_new.shape[1]
+    if missing > 0:
+        b_new = torch.cat([b_new, b_new.new_zeros(b_new.shape[0], missing)], dim=1)
+        a_new = torch.cat([a_new, a_new.new_zeros(missing, a_new.shape[1])], dim=0)
+    return b_new, a_new, kept
 
 
 def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
