@@ -33,6 +33,7 @@ from ara.errors import ConfigError
 
 CONFIG = "adapter_config.json"
 WEIGHTS = "adapter_model.safetensors"
+TOKENIZER_FILES = ("tokenizer.json", "tokenizer_config.json")
 
 
 @dataclass(frozen=True)
@@ -69,13 +70,37 @@ def _setting(config: dict, key: str):
     return frozenset(value) if isinstance(value, list) else value
 
 
+def _rank_divisor(config: dict, rank: int) -> float:
+    """What PEFT divides alpha by for ``rank``: the rank, or its root with rsLoRA."""
+    return math.sqrt(rank) if config.get("use_rslora") else rank
+
+
+def _scaling(config: dict) -> float:
+    """The factor PEFT puts in front of ``B A``."""
+    return config["lora_alpha"] / _rank_divisor(config, config["r"])
+
+
+def _write(out: Path, weights: dict, config: dict, source: Path, extras: tuple[str, ...],
+           record_name: str, record: dict) -> None:
+    """An adapter folder: the factors, their config, ``extras`` copied from ``source``
+    (unless that is ``out`` itself) and the record of how it was made."""
+    from safetensors.torch import save_file
+
+    out.mkdir(parents=True, exist_ok=True)
+    save_file(weights, str(out / WEIGHTS))
+    (out / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
+    for extra in extras:
+        if (source / extra).is_file() and source.resolve() != out.resolve():
+            shutil.copy2(source / extra, out / extra)
+    (out / record_name).write_text(json.dumps(record, indent=2) + "\n")
+
+
 def average_adapters(parts: list[SoupPart], out: Path) -> dict:
     """Write the weighted mean of ``parts`` (weights normalized to sum 1) to ``out``.
 
     Returns the soup's record (its parts, rank and alpha), also written to ``soup.json``.
     """
     import torch
-    from safetensors.torch import save_file
 
     if len(parts) < 2:
         raise ConfigError("a soup needs at least two adapters")
@@ -88,12 +113,11 @@ def average_adapters(parts: list[SoupPart], out: Path) -> dict:
             raise ConfigError(f"{part.adapter} does not adapt the same modules of the same "
                               f"base as {parts[0].adapter}: they cannot be averaged")
     total = sum(p.weight for p in parts)
-    scalings = [c["lora_alpha"] / (math.sqrt(c["r"]) if c.get("use_rslora") else c["r"])
-                for c, _ in loaded]
+    scalings = [_scaling(c) for c, _ in loaded]
     rank = sum(c["r"] for c, _ in loaded)
     # Keep the first adapter's scaling; each B factor carries its own ratio to it.
     scaling = scalings[0]
-    alpha = scaling * (math.sqrt(rank) if first_config.get("use_rslora") else rank)
+    alpha = scaling * _rank_divisor(first_config, rank)
     merged: dict[str, torch.Tensor] = {}
     for key, tensor in first_weights.items():
         if ".lora_A." in key:
@@ -105,16 +129,10 @@ def average_adapters(parts: list[SoupPart], out: Path) -> dict:
             ], dim=1).to(tensor.dtype).contiguous()
         else:
             raise ConfigError(f"{parts[0].adapter}: tensor {key} is not a LoRA factor")
-    out.mkdir(parents=True, exist_ok=True)
-    save_file(merged, str(out / WEIGHTS))
-    config = dict(first_config, r=rank, lora_alpha=alpha)
-    (out / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
-    for extra in ("tokenizer.json", "tokenizer_config.json"):
-        if (parts[0].adapter / extra).is_file():
-            shutil.copy2(parts[0].adapter / extra, out / extra)
     record = {"parts": [{"adapter": str(p.adapter), "weight": p.weight / total} for p in parts],
               "rank": rank, "lora_alpha": alpha}
-    (out / "soup.json").write_text(json.dumps(record, indent=2) + "\n")
+    _write(out, merged, dict(first_config, r=rank, lora_alpha=alpha), parts[0].adapter,
+           TOKENIZER_FILES, "soup.json", record)
     return record
 
 
@@ -147,14 +165,11 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
     norm kept: the least over modules and the mean), also written to ``reduced.json``.
     """
     import torch
-    from safetensors.torch import save_file
 
     config, weights = _load(adapter)
     if not isinstance(rank, int) or not 1 <= rank <= config["r"]:
         raise ConfigError(f"a reduced rank must be between 1 and the adapter's rank "
                           f"{config['r']}, got {rank}")
-    rslora = config.get("use_rslora")
-    scaling = config["lora_alpha"] / (math.sqrt(config["r"]) if rslora else config["r"])
     reduced: dict[str, torch.Tensor] = {}
     kept: list[float] = []
     for key, tensor in weights.items():
@@ -167,16 +182,11 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
         reduced[key] = b.to(tensor.dtype).contiguous()
         reduced[key_a] = a.to(weights[key_a].dtype).contiguous()
         kept.append(share)
-    out.mkdir(parents=True, exist_ok=True)
-    save_file(reduced, str(out / WEIGHTS))
-    alpha = scaling * (math.sqrt(rank) if rslora else rank)
-    (out / CONFIG).write_text(json.dumps(dict(config, r=rank, lora_alpha=alpha), indent=2)
-                              + "\n")
-    for extra in ("tokenizer.json", "tokenizer_config.json", "soup.json"):
-        if (adapter / extra).is_file() and adapter.resolve() != out.resolve():
-            shutil.copy2(adapter / extra, out / extra)
+    alpha = _scaling(config) * _rank_divisor(config, rank)
     record = {"rank": rank, "from_rank": config["r"], "lora_alpha": alpha,
               "norm_kept": {"least": round(min(kept), 6),
                             "mean": round(sum(kept) / len(kept), 6)}}
-    (out / "reduced.json").write_text(json.dumps(record, indent=2) + "\n")
+    # A reduced soup keeps the record of its parts.
+    _write(out, reduced, dict(config, r=rank, lora_alpha=alpha), adapter,
+           TOKENIZER_FILES + ("soup.json",), "reduced.json", record)
     return record
