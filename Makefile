@@ -3,7 +3,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-all lint bench clean
+.PHONY: setup demo test test-all lint bench lock clean
 
 setup:  ## create ./.venv with everything installed (idempotent; seconds when up to date)
 	bash scripts/setup.sh
@@ -26,6 +26,10 @@ bench: setup  ## measurements, printed as tables; not part of the tests
 	$(BIN)/python bench/translate_latency.py
 	$(BIN)/python bench/help_request_wordings.py
 	$(BIN)/python bench/self_consistency.py
+
+lock: setup  ## write the venv's versions to scripts/constraints.txt (after upgrading and testing)
+	{ sed -n '/^#/p' scripts/constraints.txt; $(BIN)/pip freeze --exclude-editable | grep -v '^torch=='; } > scripts/constraints.tmp
+	mv scripts/constraints.tmp scripts/constraints.txt
 
 clean:
 	rm -rf data/prepared .pytest_cache

@@ -3,15 +3,16 @@
 #
 #   bash scripts/setup.sh          # or: make setup
 #
-# A second run with unchanged pyproject.toml and this script returns in about a second:
-# a stamp file in .venv records the hash of both. llama-cpp-python compiles from source
-# the first time (10-20 min on 2 cores); pip caches the wheel, so later venvs reuse it.
+# A second run with unchanged pyproject.toml, scripts/constraints.txt and this script
+# returns in about a second: a stamp file in .venv records the hash of the three.
+# llama-cpp-python compiles from source the first time (10-20 min on 2 cores); pip caches
+# the wheel, so later venvs reuse it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 VENV=${ARA_VENV:-.venv}
 PYTHON=${PYTHON:-python3}
-stamp="$VENV/.ara-setup-$(cat pyproject.toml scripts/setup.sh | sha256sum | cut -c1-16)"
+stamp="$VENV/.ara-setup-$(cat pyproject.toml scripts/setup.sh scripts/constraints.txt | sha256sum | cut -c1-16)"
 
 prepare_model() {
     # The embedded GGUF as a HF folder for the transformers backend and fine-tuning;
@@ -36,7 +37,8 @@ pip install -qq torch==2.13.0
 # (SIGILL); these flags keep it to AVX2/FMA/F16C.
 export CMAKE_ARGS="${CMAKE_ARGS:--DGGML_NATIVE=OFF -DGGML_AVX2=ON -DGGML_FMA=ON -DGGML_F16C=ON -DLLAVA_BUILD=OFF}"
 echo "setup: installing the toolkit (llama-cpp-python builds from source once, ~10-20 min)"
-pip install -qq -e ".[all]"
+# The tested versions (scripts/constraints.txt), not whatever the registry has today.
+pip install -qq -e ".[all]" -c scripts/constraints.txt
 
 rm -f "$VENV"/.ara-setup-*
 touch "$stamp"

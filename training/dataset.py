@@ -19,6 +19,7 @@ from ara.data.normalize import Record
 from ara.errors import ConfigError
 from ara.eval.prompt import STOP, Shot, build_prompt
 from ara.eval.translator import ANSWER_PREFIX
+from ara.kv_cache import cache_of, with_cache
 
 IGNORE = -100
 
@@ -156,9 +157,9 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
         out = model(input_ids=ids, attention_mask=mask, logits_to_keep=keep)
     else:
         prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
-        cache = prefix.past_key_values
+        cache = cache_of(prefix)
         cache.batch_repeat_interleave(ids.shape[0])
-        out = model(input_ids=ids[:, shared:], attention_mask=mask, past_key_values=cache,
+        out = model(input_ids=ids[:, shared:], attention_mask=mask, **with_cache(cache),
                     logits_to_keep=keep - shared)
     logits = out.logits  # (batch, len(keep), vocab)
     total = torch.nn.functional.cross_entropy(

@@ -21,6 +21,7 @@ import numpy as np
 from ara.eval.backends.base import BackendError, Completion, Sampling
 from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
 from ara.grammars import BuiltGrammar
+from ara.kv_cache import cache_of, with_cache
 
 MASK_ENGINES = ("llguidance", "outlines")
 
@@ -94,8 +95,8 @@ class HFBackend:
         torch = self._torch
         with torch.inference_mode():
             out = self.model(input_ids=torch.tensor([ids], device=self.device),
-                             past_key_values=self._cache, use_cache=True)
-        self._cache = out.past_key_values
+                             use_cache=True, **with_cache(self._cache))
+        self._cache = cache_of(out)
         self._cached_ids += ids
         return out.logits[0, -1].float().cpu().numpy()
 
