@@ -7,15 +7,15 @@ construct, a time unit and a sentence layout, so one formula becomes many senten
 
 Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
 often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, then b",
-``!a U b`` "do not a until b", ``F(a & G(b))`` "eventually a, and from then on always
-b", ``(a | b) & !(a & b)`` "a or b, but not both"; in sampled sentences also ``F(a) &
-F(b)`` "a and b, in any order", ``G(a -> F(b))`` with ``b`` a command "whenever a, b",
-and over places ``F(G(a))`` "go to a and stay there", ``G(F(a))`` "keep coming back to
-a", ``G(F(a)) & G(F(b))`` "patrol between a and b"; and ``G(a -> !b)`` with ``b``
-an action "never b while a". Everything else
-is read compositionally, and a binary subformula under another operator is read in its
-bracketing form ("both ... and ...", "either ... or ...") so that the scope survives in
-the sentence.
+``F(a & F[0,n](b))`` "a, and within n steps after that, b", ``!a U b`` "do not a until
+b", ``F(a & G(b))`` "eventually a, and from then on always b", ``(a | b) & !(a & b)`` "a
+or b, but not both"; in sampled sentences also ``F(a) & F(b)`` "a and b, in any order",
+``G(a -> F(b))`` with ``b`` a command "whenever a, b", and over places ``F(G(a))`` "go
+to a and stay there", ``G(F(a))`` "keep coming back to a", ``G(F(a)) & G(F(b))``
+"patrol between a and b"; and ``G(a -> !b)`` with ``b`` an action "never b while a".
+Everything else is read compositionally, and a binary subformula under another
+operator is read in its bracketing form ("both ... and ...", "either ... or ...") so
+that the scope survives in the sentence.
 
 A few phrasings per construct are *held out* (:data:`HELD_OUT`): the compositional
 test split uses them and training never does, to measure whether a translator
@@ -136,6 +136,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
                  "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}",
                  "{a}, then {b}", "{a} first, and {b} afterwards", "after {a}, {b}",
                  "{a}; once that is done, {b}", "{a} and {b}, in that order"),
+    # F(a & F[0,n](b)): the second step has a deadline counted from the first.
+    "sequence_n": ("{a}, and within {n} {u} after that, {b}", "first {a}, then {b} within {n} {u}",
+                   "{a}, then within {n} {u} {b}", "after {a}, {b} within {n} {u}",
+                   "{a}, and no more than {n} {u} later, {b}"),
     "sequence3": ("first {a}, then {b}, then {c}", "{a}, then {b}, and finally {c}",
                   "{a}, after that {b}, and after that {c}", "{a}, then {b}, then {c}",
                   "in this order: {a}, {b}, {c}", "{a}, {b}, and then {c}",
@@ -198,6 +202,7 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "invariant": frozenset({"always, if {a}, then {b}"}),
     "invariant_not": frozenset({"{b} is not allowed while {a}"}),
     "sequence": frozenset({"{a}, followed by {b}"}),
+    "sequence_n": frozenset({"{a}, and no more than {n} {u} later, {b}"}),
     "sequence3": frozenset({"in this order: {a}, {b}, {c}"}),
     "visit_any": frozenset({"{l}, the order does not matter"}),
     "U": frozenset({"continue {a} until {b}"}),
@@ -474,7 +479,17 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
                 and r.is_action(rhs.arg.name) and r.rng is not None and r.rng.random() < 0.5:
             # "never touch the pan while the stove is on"
             return r.pick("invariant_not", used, a=sub(lhs), b=sub(rhs.arg))
-        return r.pick("invariant", used, allow=_only(lhs), a=sub(lhs), b=said or sub(rhs))
+        # "a only when b" needs a condition for b: "you charge only when hold the box"
+        told = rhs.arg if isinstance(rhs, Not) else rhs
+        command = isinstance(told, Atom) and r.is_action(told.name)
+        return r.pick("invariant", used, allow=lambda p: _only(lhs)(p) and not (
+            command and " only " in p), a=sub(lhs), b=said or sub(rhs))
+    inner = _untimed(f, Eventually)
+    if isinstance(inner, And) and len(inner.args) == 2 and isinstance(inner.args[1], Eventually) \
+            and inner.args[1].interval is not None and inner.args[1].interval.lo == 0 \
+            and inner.args[1].interval.hi is not None:
+        return r.pick("sequence_n", used, a=sub(inner.args[0]), b=sub(inner.args[1].arg),
+                      n=inner.args[1].interval.hi)
     steps = _sequence(f)
     if steps is not None and len(steps) == 2:
         return r.pick("sequence", used, a=sub(steps[0]), b=sub(steps[1]))
@@ -547,4 +562,8 @@ def _sequence(f: Formula) -> list[Formula] | None:
     if not (isinstance(tail, Eventually) and tail.interval is None):
         return None
     rest = _sequence(tail)
+    if rest is None and _untimed(tail.arg, Always) is not None:
+        # A last step for good is said whole ("then go to the dock and stay there"):
+        # "first a, then always b" would be F(a & G(b)), b from a's moment on.
+        return [head, tail]
     return [head] + (rest if rest is not None else [tail.arg])

@@ -7,7 +7,7 @@
 # then export, ship and the evaluations (about 45 min).
 #
 #   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 v10 v11 v12 v13
-#                                         v14 v15 v16 v17 soup export ship eval paper disjoint
+#                                         v14 v15 v16 v17 v18 soup export ship eval paper disjoint
 #                                         full
 #                                         (default: train continue v13 v14 v15 soup v16
 #                                         export ship eval)
@@ -98,7 +98,7 @@ for step in $steps; do
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
     train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
-  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15|v16|v17)
+  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15|v16|v17|v18)
     train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
       "runs/train/gemma3-270m-lora-compositional-$step" ;;
   soup)
@@ -134,7 +134,7 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 soup export" \
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 v18 soup export" \
        "ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac

@@ -12,6 +12,7 @@ from ara.data.synthetic import (
     PATTERN_MAX_DEPTH,
     SynthSettings,
     is_held_out,
+    pattern_shapes,
     roles_of,
     sample_formula,
     shape,
@@ -182,7 +183,7 @@ def test_an_action_may_trigger_a_response_said_as_an_event(train_records):
         verb, _, thing = r.formula.arg.lhs.name.partition("_")
         # never "you red box" for pick_red_box; a lone verb's event is "you report"
         assert not thing or f"you {thing.replace('_', ' ')}" not in r.nl
-        assert re.search(r"\b(you|is|are|sounds) ", r.nl), r.nl
+        assert re.search(r"\b(you|is|are|sounds)\b", r.nl), r.nl
 
 
 def test_roles_of_a_response_with_an_action_trigger():
@@ -195,9 +196,9 @@ def test_roles_of_a_response_with_an_action_trigger():
 
 
 def test_an_invariant_may_forbid_any_action(train_records):
-    """Tests that G(c -> !b) is taught with achievements as b, said "never b while c"
-    ("never pick up the red box while the alarm is on"), and that b stays a state
-    where it occurs elsewhere too."""
+    """Tests that G(c -> !b) is taught with achievements as b, said as a prohibition
+    ("never pick up the red box while the alarm is on", "whenever you charge, don't
+    grab the crate"), and that b stays a state where it occurs elsewhere too."""
     achievements = tuple(p for p in ACTION_PREFIXES if p not in LASTING_PREFIXES)
     forbidding = [r for r in train_records if r.form == "grounded"
                   and isinstance(r.formula, Always) and isinstance(r.formula.arg, Implies)
@@ -205,7 +206,7 @@ def test_an_invariant_may_forbid_any_action(train_records):
                   and isinstance(r.formula.arg.rhs.arg, Atom)
                   and r.formula.arg.rhs.arg.name.startswith(achievements)]
     assert forbidding
-    assert [r for r in forbidding if re.search(r"\b(never|do not|must not) .* (while|when) ",
+    assert [r for r in forbidding if re.search(r"\b(never|do not|don't|must not) ",
                                                r.nl.lower())]
     assert roles_of(parse("G(a -> !b)")).states == frozenset()
     assert roles_of(parse("G(a -> !b) & F(b)")).states == {"b"}
@@ -239,6 +240,20 @@ def test_held_out_shapes_stay_on_the_test_side(train_records):
     assert not any(is_held_out(r.formula, s) for r in train_records)
     assert all(is_held_out(r.formula, s) for r in test)
     assert not {shape(r.formula) for r in test} & {shape(r.formula) for r in train_records}
+
+
+def test_the_patterns_users_write_are_never_held_out(train_records):
+    """Tests that the split holds out compositions, not the everyday patterns: the
+    two-step sequence and the bounded response were once held out by their hash."""
+    s = SynthSettings(held_out_percent=50)
+    for everyday in ("F(a & F(b))", "G(a -> F[0,30](b))", "F(a & F[0,9](b))",
+                     "F(a & F(G(b)))", "F(a & F(b & F(c)))", "(F(a) & F(b)) & F(c)"):
+        assert shape(parse(everyday)) in pattern_shapes()
+        assert not is_held_out(parse(everyday), s)
+    assert any(is_held_out(sample_formula(random.Random(i), s, ["a", "b", "c"]), s)
+               for i in range(50))
+    deadlines = [r for r in train_records if re.fullmatch(r"F\(\w+ & F\[0,\d+\]\(\w+\)\)", r.stl)]
+    assert deadlines and any("after that" in r.nl or "later" in r.nl for r in deadlines)
 
 
 def test_shape_blanks_names_and_bounds():

@@ -22,6 +22,9 @@ from conftest import formulas
         ("F(G(a))", "eventually a forever"),
         ("F(a & F(b))", "first a, then b"),
         ("F(a & F(b & F(c)))", "first a, then b, then c"),
+        # a deadline counted from the step before, and a last step for good
+        ("F(a & F[0,10](b))", "a, and within 10 steps after that, b"),
+        ("F(a & F(G(b)))", "first a, then eventually b forever"),
         ("G(a -> F[0,5](b))", "whenever a, b within 5 steps"),
         ("G[0,7](!a)", "never a in the first 7 steps"),
         ("F[3,9](a)", "at some point between step 3 and step 9, a"),
