@@ -7,10 +7,10 @@
 # then export, ship and the evaluations (about 45 min).
 #
 #   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 v10 v11 v12 v13
-#                                         v14 v15 v16 v17 v18 soup export ship eval paper disjoint
-#                                         full
-#                                         (default: train continue v13 v14 v15 soup v16
-#                                         export ship eval)
+#                                         v14 v15 v16 v17 v18 soup soup17 export ship eval
+#                                         paper disjoint full
+#                                         (default: train continue v13 v14 v15 soup v16 v17
+#                                         soup17 export ship eval)
 #
 # train: v3 (training/configs/gemma3_270m_lora_cpu_compositional.yaml); continue: v4,
 #   400 more steps from v3's adapter (..._compositional_v4.yaml); v6, v7, v8: three more
@@ -47,10 +47,10 @@ bin=.venv/bin
 first_run=runs/train/gemma3-270m-lora-compositional
 v4_run=runs/train/gemma3-270m-lora-compositional-v4
 soup_run=runs/train/gemma3-270m-lora-compositional-soup
-run=runs/train/gemma3-270m-lora-compositional-v16
+run=runs/train/gemma3-270m-lora-compositional-soup-v16v17
 paper_run=runs/train/gemma3-270m-lora
 disjoint_run=runs/train/gemma3-270m-lora-disjoint
-steps=${*:-train continue v13 v14 v15 soup v16 export ship eval}
+steps=${*:-train continue v13 v14 v15 soup v16 v17 soup17 export ship eval}
 
 train() {  # CONFIG RUN_FOLDER
   if [ -f "$2/run.json" ]; then resume=--resume; else resume=; fi
@@ -105,6 +105,10 @@ for step in $steps; do
     # The committed records of the parts; a rerun's parts are in runs/train/..-vN
     parts=docs/results/training/compositional-270m
     $bin/ara soup --run $parts-soup-v13v14 --run $parts-v15 --rank 16 --out "$soup_run" ;;
+  soup17)
+    # v16 and v17 (v16 trained on, seed 10), their mean at rank 16: shipped
+    parts=docs/results/training/compositional-270m
+    $bin/ara soup --run $parts-v16 --run $parts-v17 --rank 16 --out "$run" ;;
   export)
     # f16 GGUF of the merged model + the adapter alone as a GGUF LoRA; parity on 20 pairs
     $bin/ara export --run "$run" --quant f16 --lora-gguf --parity 20 ;;
@@ -134,8 +138,8 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 v18 soup export" \
-       "ship eval paper disjoint full)" >&2
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 v18 soup soup17" \
+       "export ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac
 done

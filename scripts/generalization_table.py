@@ -81,6 +81,8 @@ MODELS = {
                                        ("compositional", "89be643cc979")),
     "compositional-adapter-v18-270m": ("compositional adapter v18 (v16 on 3.6.0)",
                                        ("compositional", "e910409c3f2c")),
+    "soup-v16v17-270m": ("soup v16+v17 at rank 16", ("compositional", "89be643cc979")),
+    "soup-v16v18-270m": ("soup v16+v18 at rank 16", ("compositional", "e910409c3f2c")),
     "soup-v11v12v13-270m": ("soup v11+v12+v13 (not shipped)", ("compositional", "9c33668eac7c")),
     "soup-v7v8-270m": ("soup v7+v8 (shipped until 2026-11-23)",
                        ("compositional", "6c3132045205")),
@@ -88,7 +90,8 @@ MODELS = {
                           ("compositional", "6c3132045205")),
     "soup-v11v12-270m": ("soup v11+v12 (shipped until 2026-11-24)",
                          ("compositional", "690d5d4a1e5f")),
-    "compositional-adapter-270m": ("v16 (shipped)",
+    "v16-shipped-270m": ("v16 (shipped until 2026-11-24)", ("compositional", "89be643cc979")),
+    "compositional-adapter-270m": ("soup v16+v17 (shipped)",
                                    ("compositional", "89be643cc979")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),

@@ -29,7 +29,7 @@ def finetuned(embedded_model_path):
 
 
 @pytest.mark.parametrize(("adapter", "version"), [
-    (FINETUNED_LORA, "89be643cc979"),  # v16, on generator 3.5.0's mixture
+    (FINETUNED_LORA, "89be643cc979"),  # the soup of v16 and v17, both on generator 3.5.0
     (PAPER_LORA, "1de1d813ead6"),  # the registered paper split
 ])
 def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
