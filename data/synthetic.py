@@ -309,8 +309,10 @@ def _blank(f: Formula) -> Formula:
 def is_held_out(f: Formula, s: SynthSettings) -> bool:
     """Whether ``f``'s shape belongs to the compositional test split."""
     operators = sum(not isinstance(n, Atom) for n in walk(f))
-    key = int(hashlib.sha256(shape(f).encode()).hexdigest()[:8], 16)
-    return operators >= 3 and key % 100 < s.held_out_percent and shape(f) not in pattern_shapes()
+    its_shape = shape(f)
+    key = int(hashlib.sha256(its_shape.encode()).hexdigest()[:8], 16)
+    return (operators >= 3 and key % 100 < s.held_out_percent
+            and its_shape not in pattern_shapes())
 
 
 # -- records ----------------------------------------------------------------------------
