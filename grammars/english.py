@@ -457,9 +457,14 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
     if patrol is not None:
         return r.pick("GF2_place", used, x=patrol[0], y=patrol[1])
     inner = _untimed(f, Eventually)
-    if isinstance(inner, And) and len(inner.args) == 2 \
-            and _untimed(inner.args[1], Always) is not None:
-        return r.pick("F_then_G", used, a=sub(inner.args[0]), b=sub(inner.args[1].arg))
+    if isinstance(inner, And) and len(inner.args) == 2:
+        head, tail = inner.args
+        if _untimed(tail, Always) is not None:
+            return r.pick("F_then_G", used, a=sub(head), b=sub(tail.arg))
+        deadline = tail.interval if isinstance(tail, Eventually) else None
+        if deadline is not None and deadline.lo == 0 and deadline.hi is not None:
+            # The second step has a deadline counted from the first.
+            return r.pick("sequence_n", used, a=sub(head), b=sub(tail.arg), n=deadline.hi)
     if _is_xor(f):
         one, other = f.args[0].args
         return r.pick("xor", used, a=_choice(one, r, used, now), b=_choice(other, r, used, now))
@@ -484,12 +489,6 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         command = isinstance(told, Atom) and r.is_action(told.name)
         return r.pick("invariant", used, allow=lambda p: _only(lhs)(p) and not (
             command and " only " in p), a=sub(lhs), b=said or sub(rhs))
-    inner = _untimed(f, Eventually)
-    if isinstance(inner, And) and len(inner.args) == 2 and isinstance(inner.args[1], Eventually) \
-            and inner.args[1].interval is not None and inner.args[1].interval.lo == 0 \
-            and inner.args[1].interval.hi is not None:
-        return r.pick("sequence_n", used, a=sub(inner.args[0]), b=sub(inner.args[1].arg),
-                      n=inner.args[1].interval.hi)
     steps = _sequence(f)
     if steps is not None and len(steps) == 2:
         return r.pick("sequence", used, a=sub(steps[0]), b=sub(steps[1]))
