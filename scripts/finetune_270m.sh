@@ -7,8 +7,8 @@
 # then export, ship and the evaluations (about 45 min).
 #
 #   scripts/finetune_270m.sh [STEP ...]   steps: train continue v6 v7 v8 v9 v10 v11 v12 v13
-#                                         v14 v15 v16 v17 v18 soup soup17 export ship eval
-#                                         paper disjoint full
+#                                         v14 v15 v16 v17 v18 v19 v20 soup soup17 export
+#                                         ship eval paper disjoint full
 #                                         (default: train continue v13 v14 v15 soup v16 v17
 #                                         soup17 export ship eval)
 #
@@ -27,8 +27,10 @@
 #   16 by SVD (`ara soup --rank 16`, from the adapters committed under
 #   docs/results/training/; shipped at rank 64 until 2026-11-24; committed as
 #   compositional-270m-soup-v13v14v15-r16); v16: 300 steps from that soup on
-#   89be643cc979, seed 9, the help requests counted twice; export/ship: v16 becomes
-#   `--model finetuned`. A mixture that is no longer
+#   89be643cc979, seed 9, the help requests counted twice; v17: 300 more from v16, seed
+#   10; soup17: the mean of v16 and v17 at rank 16; export/ship: it becomes `--model
+#   finetuned`. v18 to v20 (on 3.6.0's e910409c3f2c, from v16 and from the shipped soup)
+#   were not shipped and are not in the default steps. A mixture that is no longer
 #   registered (v6 to v13's) is prepared with the release that registered it
 #   (`git log -p data/versions.json`).
 # eval: the generalization runs of the new adapter, the paper-split adapter and the base
@@ -98,7 +100,7 @@ for step in $steps; do
     train training/configs/gemma3_270m_lora_cpu_compositional.yaml "$first_run" ;;
   continue)
     train training/configs/gemma3_270m_lora_cpu_compositional_v4.yaml "$v4_run" ;;
-  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15|v16|v17|v18)
+  v6|v7|v8|v9|v10|v11|v12|v13|v14|v15|v16|v17|v18|v19|v20)
     train "training/configs/gemma3_270m_lora_cpu_compositional_$step.yaml" \
       "runs/train/gemma3-270m-lora-compositional-$step" ;;
   soup)
@@ -138,7 +140,8 @@ for step in $steps; do
   full)
     ablation paper finetuned docs/results/compositional-adapter-270m-paper-full C 3000
     $bin/ara eval ceiling --split paper ;;
-  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 v18 soup soup17" \
+  *) echo "unknown step $step (train continue v6 v7 v8 v9 v10 v11 v12 v13 v14 v15 v16 v17 v18 v19" \
+       "v20 soup soup17" \
        "export ship eval paper disjoint full)" >&2
      exit 2 ;;
   esac
