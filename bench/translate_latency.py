@@ -11,6 +11,9 @@ under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one w
 call first. A formula's time depends on its length, so tokens per answer are shown too.
 Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
 with the default grammar, so a candidate is timed beside what ships, in the same run.
+``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`):
+its median is the greedy answer's, its mean carries the extra answers drawn for the
+few whose greedy answer leaves part of the request out.
 """
 
 from __future__ import annotations
@@ -22,14 +25,19 @@ import random
 import statistics
 
 from ara.data import load_or_prepare
+from ara.eval.consistency import translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator, TranslatorConfig
 
 
-def measure(translator: Translator, records) -> dict:
+def measure(translator: Translator, records, repair: int = 0) -> dict:
     translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
-    runs = [translator.translate(r.nl, r.aps) for r in records]
-    ms = [r.ms for r in runs]
+    if repair:
+        votes = [translate_repaired(translator, r.nl, r.aps, samples=repair) for r in records]
+        runs, ms = [v.result for v in votes], [v.ms for v in votes]
+    else:
+        runs = [translator.translate(r.nl, r.aps) for r in records]
+        ms = [r.ms for r in runs]
     return {"median_ms": statistics.median(ms), "mean_ms": statistics.fmean(ms),
             "tokens": statistics.fmean(r.completion_tokens for r in runs)}
 
@@ -40,6 +48,8 @@ def main() -> None:
     ap.add_argument("--candidate", action="append", default=[], metavar="MODEL",
                     help="another --model value to time with the default grammar "
                          "(repeatable), e.g. lora:runs/soup/x/lora.gguf")
+    ap.add_argument("--repair", type=int, default=8,
+                    help="extra answers for the repair row (0: no such row)")
     args = ap.parse_args()
     records = random.Random(0).sample(load_or_prepare("handwritten").records("test", "grounded"),
                                       args.n)
@@ -49,17 +59,20 @@ def main() -> None:
           "median vs earlier default |")
     print("|---|---|---:|---:|---:|---:|")
     rows = [("finetuned-paper", TranslatorConfig(intervals=False), "earlier default",
-             "no time bounds"),
-            ("finetuned", TranslatorConfig(), "default", "bounds the sentence writes"),
+             "no time bounds", 0),
+            ("finetuned", TranslatorConfig(), "default", "bounds the sentence writes", 0),
+            *([("finetuned", TranslatorConfig(), f"--repair {args.repair}",
+                "bounds the sentence writes", args.repair)] if args.repair else []),
             ("finetuned", TranslatorConfig(bounds_from_request=False), "--any-bound",
-             "any bound up to 1000"),
-            ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds"),
-            *[(model, TranslatorConfig(), "candidate", "bounds the sentence writes")
+             "any bound up to 1000", 0),
+            ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds",
+             0),
+            *[(model, TranslatorConfig(), "candidate", "bounds the sentence writes", 0)
               for model in args.candidate]]
     base = None
-    for model, config, label, grammar in rows:
+    for model, config, label, grammar, repair in rows:
         t = Translator(make_backend(model), config)
-        m = measure(t, records)
+        m = measure(t, records, repair)
         base = base or m["median_ms"]
         print(f"| {model} ({label}) | {grammar} | "
               f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {m['tokens']:.1f} | "

@@ -5,6 +5,11 @@ all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
 ``F(a | b)`` vote together. The largest group wins; a tie goes to the group holding the
 greedy answer, so with one sample this is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
+
+Repair (:func:`translate_repaired`) draws the extra answers only when the greedy one
+leaves out a listed proposition or a stated bound (:mod:`ara.eval.coverage`), and then
+prefers the answers that leave out least; the greedy answer stays unless a sample
+says more of the request. On a complete greedy answer it costs nothing.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ from dataclasses import dataclass
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
+from ara.eval.coverage import gaps
 from ara.eval.prompt import Shot
 from ara.eval.translator import TranslationResult, Translator
 from ara.grammars import parse
@@ -70,13 +76,76 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
         raise ConfigError(f"samples must be >= 1, got {samples}")
     start = time.perf_counter()
     results = [translator.translate(nl, aps, shots, grammar_in_prompt)]
-    for i in range(1, samples):
-        sampling = Sampling(temperature=temperature, seed=seed + i)
-        results.append(translator.translate(nl, aps, shots, grammar_in_prompt,
-                                            sampling=sampling))
+    results += _draw(translator, nl, aps, shots, samples - 1, temperature, seed,
+                     grammar_in_prompt)
     groups = _group([r.stl for r in results], timeout_s)
     ranked = sorted(groups, key=lambda g: (-len(g), g[0]))
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
+
+
+def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
+                       shots: Sequence[Shot] = (), samples: int = 8,
+                       temperature: float = 0.7, seed: int = 0, timeout_s: float = 10.0,
+                       grammar_in_prompt: bool = False) -> Vote:
+    """Translate ``nl`` greedily; if the answer leaves out part of the request, draw
+    ``samples`` more under the grammar and keep the majority meaning among those that
+    leave out least.
+
+    Args:
+        translator, nl, aps, shots, temperature, timeout_s, grammar_in_prompt: As
+            :func:`translate_consistent`.
+        samples: Extra answers to draw when the greedy one has a gap, >= 0 (0: greedy).
+        seed: Extra answer ``i`` (from 1) is drawn with seed ``seed + i``.
+
+    Returns:
+        A :class:`Vote` of one answer when the greedy one leaves nothing out or
+        ``samples`` is 0; otherwise of all, greedy first. The greedy answer wins unless
+        a sample leaves out less.
+    """
+    if samples < 0:
+        raise ConfigError(f"samples must be >= 0, got {samples}")
+    start = time.perf_counter()
+    greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
+    results = [greedy]
+    if samples and 0 < _missing(nl, aps, greedy.stl) < float("inf"):
+        results += _draw(translator, nl, aps, shots, samples, temperature, seed,
+                         grammar_in_prompt)
+    ranked = rank_repairs([r.stl for r in results],
+                          [_missing(nl, aps, r.stl) for r in results], timeout_s)
+    return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
+
+
+def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
+                 timeout_s: float = 10.0) -> list[tuple[int, ...]]:
+    """Groups of ``answers`` (greedy first), the winner first.
+
+    ``missing[i]`` is how much of the request answer ``i`` leaves out. If no answer
+    leaves out less than the greedy one, the greedy one's group wins; otherwise the
+    largest group of the answers that leave out least (answers that leave out more
+    stand alone, after them).
+    """
+    least = min(missing)
+    if least == missing[0]:
+        ranked = _group(answers, timeout_s)
+        ranked.sort(key=lambda g: (g[0] != 0, -len(g), g[0]))
+    else:
+        best = [a if m == least else None for a, m in zip(answers, missing, strict=True)]
+        ranked = _group(best, timeout_s)
+        ranked.sort(key=lambda g: (missing[g[0]] != least, -len(g), g[0]))
+    return ranked
+
+
+def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],
+          n: int, temperature: float, seed: int,
+          grammar_in_prompt: bool) -> list[TranslationResult]:
+    return [translator.translate(nl, aps, shots, grammar_in_prompt,
+                                 sampling=Sampling(temperature=temperature, seed=seed + i))
+            for i in range(1, n + 1)]
+
+
+def _missing(nl: str, aps: Sequence[str], stl: str | None) -> float:
+    """How much of the request an answer leaves out (an unparsed one: everything)."""
+    return len(gaps(nl, aps, parse(stl))) if stl is not None else float("inf")
 
 
 def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, ...]]:

@@ -20,6 +20,7 @@ from ara import __version__
 from ara.data import PreparedSplit, Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
+from ara.eval.consistency import translate_repaired
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
@@ -75,6 +76,10 @@ class AblationConfig:
         model: What ``--model`` named (recorded; the backend reports its hash).
         spot_timeout_s: Time limit per Spot check; past it the pair counts as undecided.
         translator: Grammar and budget settings.
+        repair: With C: when the greedy answer leaves out a listed proposition or a
+            stated bound, draw this many more (seeded, T=0.7) and keep the majority of
+            those that leave out least (:func:`~ara.eval.consistency.translate_repaired`);
+            0 (the paper's variants): greedy only.
     """
 
     split: str = "paper"
@@ -88,6 +93,7 @@ class AblationConfig:
     model: str = "default"
     spot_timeout_s: float = 10.0
     translator: TranslatorConfig = field(default_factory=TranslatorConfig)
+    repair: int = 0
 
     def __post_init__(self) -> None:
         if self.split not in SPLITS:
@@ -100,17 +106,19 @@ class AblationConfig:
             # express a single reference.
             object.__setattr__(self, "translator", replace(self.translator, intervals=True))
         if (not self.variants or any(not 0 <= k <= MAX_SHOTS for k in self.shots)
-                or self.reruns < 1 or self.limit < 1):
+                or self.reruns < 1 or self.limit < 1 or not 0 <= self.repair <= 32):
             raise ConfigError(
-                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1 and "
-                "limit >= 1; got "
+                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1, "
+                "limit >= 1 and repair from 0 to 32; got "
                 f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
-                f"limit={self.limit}"
+                f"limit={self.limit}, repair={self.repair}"
             )
 
     def to_dict(self) -> dict:
         data = asdict(self)
         data["variants"], data["shots"] = list(self.variants), list(self.shots)
+        if not self.repair:  # as runs from before repair existed wrote it: they resume
+            del data["repair"]
         return data
 
     @classmethod
@@ -197,22 +205,40 @@ def judge(reference: str, output: str | None, timeout_s: float) -> dict:
         return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
-def translate_job(translator: Translator, job: Job) -> TranslationResult:
+@dataclass(frozen=True)
+class Answer:
+    """A job's translation, and how many generations it took (more than one: repaired)."""
+
+    result: TranslationResult
+    attempts: int = 1
+    ms: float | None = None
+
+    @property
+    def total_ms(self) -> float:
+        return self.result.ms if self.ms is None else self.ms
+
+
+def translate_job(translator: Translator, job: Job, repair: int = 0) -> Answer:
     """The generation of one job (what may run concurrently against a server)."""
     r = job.record
-    return translator.translate(r.nl, r.aps, job.examples, job.variant.grammar_in_prompt,
-                                job.variant.constrained)
+    if repair and job.variant.constrained:
+        vote = translate_repaired(translator, r.nl, r.aps, job.examples, samples=repair,
+                                  grammar_in_prompt=job.variant.grammar_in_prompt)
+        return Answer(vote.result, len(vote.results), vote.ms)
+    return Answer(translator.translate(r.nl, r.aps, job.examples,
+                                       job.variant.grammar_in_prompt, job.variant.constrained))
 
 
-def sample_of(job: Job, result: TranslationResult, timeout_s: float) -> dict:
+def sample_of(job: Job, answer: Answer, timeout_s: float) -> dict:
     """One line of samples.jsonl: the job, its translation and Spot's verdicts."""
-    r = job.record
+    r, result = job.record, answer.result
     return {
         "variant": job.variant.name, "shots": job.shots, "rerun": job.rerun, "uid": r.uid,
         "nl": r.nl, "aps": list(r.aps), "reference": r.stl, "raw": result.raw,
         "stl": result.stl, "valid": result.valid, "error": result.error,
         **judge(r.stl, result.stl, timeout_s),
-        "ms": round(result.ms, 2), "prompt_tokens": result.prompt_tokens,
+        "ms": round(answer.total_ms, 2), "attempts": answer.attempts,
+        "prompt_tokens": result.prompt_tokens,
         "completion_tokens": result.completion_tokens, "cached_tokens": result.cached_tokens,
         "stop": result.stop, "masked_steps": result.masked_steps,
         "prompt_sha256": result.prompt_sha256,

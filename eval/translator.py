@@ -123,10 +123,10 @@ class RequestError(AraError, ValueError):
 
 
 _STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
-_NUMBER_WORDS = {w: i for i, w in enumerate(
+NUMBER_WORDS = {w: i for i, w in enumerate(
     "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
     "fifteen sixteen seventeen eighteen nineteen twenty".split())}
-_NUMBER_WORDS |= {w: 10 * (i + 3) for i, w in enumerate(
+NUMBER_WORDS |= {w: 10 * (i + 3) for i, w in enumerate(
     "thirty forty fifty sixty seventy eighty ninety".split())} | {"hundred": 100}
 
 
@@ -137,7 +137,7 @@ def _digit_numbers(nl: str) -> list[int]:
 def request_numbers(nl: str) -> set[int]:
     """The numbers an instruction writes, as digits or as words ("ten", "thirty")."""
     words = re.findall(r"[a-z]+", nl.lower())
-    return set(_digit_numbers(nl)) | {_NUMBER_WORDS[w] for w in words if w in _NUMBER_WORDS}
+    return set(_digit_numbers(nl)) | {NUMBER_WORDS[w] for w in words if w in NUMBER_WORDS}
 
 
 def mentions(nl: str, ap: str) -> bool:

@@ -171,6 +171,8 @@ def test_explain_reads_a_formula_back_in_english():
         (["go to the kitchen", "--aps", "go_to_kitchen,pick_red_box"],
          "never mentions pick_red_box"),  # a proposition the sentence never names
         (["reach prop_1 within 5000 steps", "--aps", "prop_1"], "pass --max-bound 5000"),
+        (["always (prop_1)", "--aps", "prop_1", "--samples", "3", "--repair", "2"],
+         "pass one"),
     ],
 )
 def test_translate_refuses_a_request_it_cannot_honour(args, message):

@@ -15,7 +15,7 @@ FORMULAS = ["F(a)", "G(!b) & F(a)", "a U b", "F[0,5](a)", "F(a & )", "((a)", "",
 WORDS = ["--json", "--aps", "a,b", "a", "", ",,", "1", "-1", "99999", "--shots", "--seed",
          "--max-bound", "0", "--at", "a=0,7", "a=1,1", "b=99,99", "a=x", "=", "--start",
          "0,0", "9,9", "--split", "paper", "nope", "--form", "grounded", "--timeout", "0.5",
-         "--no-intervals", "--any-bound", "--samples", "0", "--temperature", "-3",
+         "--no-intervals", "--any-bound", "--samples", "0", "--temperature", "-3", "--repair",
          "--model", "no-such-model", "lora:missing.gguf", "--world", "/nonexistent"]
 COMMANDS = [["stl", "parse"], ["stl", "explain"], ["stl", "equiv"], ["stl", "implies"],
             ["coord", "plan"], ["data", "stats"], ["data", "prepare"], ["translate"]]

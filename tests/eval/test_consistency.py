@@ -6,8 +6,10 @@ import pytest
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
-from ara.eval.consistency import _group, translate_consistent
+from ara.eval.consistency import _group, rank_repairs, translate_consistent, translate_repaired
+from ara.eval.coverage import gaps
 from ara.eval.translator import Translator
+from ara.grammars import parse
 
 from conftest import needs_llama
 
@@ -54,3 +56,34 @@ def test_one_sample_is_greedy_and_the_vote_is_reproducible(llama_backend):
     assert len(vote.groups[0]) == max(len(g) for g in vote.groups)
     with pytest.raises(ConfigError, match="samples must be >= 1"):
         translate_consistent(t, nl, aps, samples=0)
+
+
+def test_repair_keeps_greedy_unless_a_sample_leaves_out_less():
+    """Tests the ranking of repaired answers: the greedy answer (index 0) wins while no
+    sample says more of the request; otherwise the majority of the most complete ones."""
+    answers = ("F(a)", "F(a) & G(!b)", "G(!b) & F(a)", "F(a | b)", "F(a)")
+    assert rank_repairs(answers, [1, 1, 1, 1, 1])[0] == (0, 4)
+    assert rank_repairs(answers, [1, 0, 0, 0, 1])[0] == (1, 2)
+    assert rank_repairs(answers, [1, 0, 0, 0, 1])[1] == (3,)
+    assert rank_repairs(answers, [0, 0, 0, 0, 0])[0] == (0, 4)
+
+
+@needs_llama
+def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
+    """Tests that repair draws extra answers exactly when the greedy one leaves part of
+    the request out, that its winner leaves out no more than greedy, and that it is
+    reproducible."""
+    t = Translator(llama_backend)
+    aps = ("prop_1", "prop_2")
+    nl = "within 20 steps reach (prop_1), and never (prop_2)"
+    greedy = t.translate(nl, aps)
+    greedy_gaps = len(gaps(nl, aps, parse(greedy.stl)))
+    vote = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5)
+    assert vote.answers[0] == greedy.stl
+    assert len(vote.results) == (4 if greedy_gaps else 1)
+    assert len(gaps(nl, aps, parse(vote.result.stl))) <= greedy_gaps
+    again = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5)
+    assert (again.answers, again.groups) == (vote.answers, vote.groups)
+    assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
+    with pytest.raises(ConfigError, match="samples must be >= 0"):
+        translate_repaired(t, nl, aps, samples=-1)

@@ -40,6 +40,16 @@ def test_config_round_trips_and_refuses_unknown_keys():
         AblationConfig(split="disjont")
 
 
+def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
+    """Tests that a run without repair writes the config runs wrote before repair
+    existed (a resumed run must match it), and that repair round-trips and is bounded."""
+    assert "repair" not in AblationConfig().to_dict()
+    repaired = AblationConfig(repair=8)
+    assert AblationConfig.from_dict(repaired.to_dict()) == repaired
+    with pytest.raises(ConfigError, match="repair from 0 to 32"):
+        AblationConfig(repair=33)
+
+
 def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):
     """Tests the plan's size, uniqueness, and shared examples within a run."""
     split = paper_split
