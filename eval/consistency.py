@@ -107,11 +107,13 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     start = time.perf_counter()
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
     results = [greedy]
-    if samples and 0 < _missing(nl, aps, greedy.stl) < float("inf"):
+    # Without intervals no answer can write a bound: only propositions can be mended.
+    bounds = translator.config.intervals
+    if samples and 0 < _missing(nl, aps, greedy.stl, bounds) < float("inf"):
         results += _draw(translator, nl, aps, shots, samples, temperature, seed,
                          grammar_in_prompt)
     ranked = rank_repairs([r.stl for r in results],
-                          [_missing(nl, aps, r.stl) for r in results], timeout_s)
+                          [_missing(nl, aps, r.stl, bounds) for r in results], timeout_s)
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
@@ -143,9 +145,13 @@ def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[S
             for i in range(1, n + 1)]
 
 
-def _missing(nl: str, aps: Sequence[str], stl: str | None) -> float:
-    """How much of the request an answer leaves out (an unparsed one: everything)."""
-    return len(gaps(nl, aps, parse(stl))) if stl is not None else float("inf")
+def _missing(nl: str, aps: Sequence[str], stl: str | None, bounds: bool = True) -> float:
+    """How much of the request an answer leaves out (an unparsed one: everything);
+    without ``bounds``, only the propositions count."""
+    if stl is None:
+        return float("inf")
+    gap = gaps(nl, aps, parse(stl))
+    return len(gap) if bounds else len(gap.aps)
 
 
 def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, ...]]:

@@ -17,7 +17,7 @@ from functools import lru_cache
 from ara.errors import AraError, ConfigError, STLSyntaxError
 from ara.eval.backends.base import Backend, Sampling
 from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
-from ara.grammars import BuiltGrammar, Syntax, build_grammar, parse, to_text
+from ara.grammars import BuiltGrammar, Syntax, build_grammar, parse, require_literals, to_text
 
 #: The space a model writes after "STL:"; part of the decoding grammar, stripped after.
 ANSWER_PREFIX = " "
@@ -187,6 +187,14 @@ def decoding_grammar(built: BuiltGrammar) -> BuiltGrammar:
                         built.grammar.with_prefix(ANSWER_PREFIX).with_suffix(STOP))
 
 
+@lru_cache(maxsize=256)
+def _requiring(built: BuiltGrammar, texts: tuple[str, ...]) -> BuiltGrammar:
+    try:
+        return BuiltGrammar(built.syntax, require_literals(built.grammar, texts))
+    except ValueError as err:
+        raise ConfigError(f"cannot require {', '.join(texts)} of this request: {err}") from None
+
+
 class Translator:
     """Translate instructions with one backend.
 
@@ -205,7 +213,8 @@ class Translator:
 
     def translate(self, nl: str, aps: Sequence[str], shots: Sequence[Shot] = (),
                   grammar_in_prompt: bool = False, constrained: bool = True,
-                  sampling: Sampling | None = None) -> TranslationResult:
+                  sampling: Sampling | None = None,
+                  require: Sequence[str] = ()) -> TranslationResult:
         """Translate ``nl`` over the propositions ``aps``.
 
         Args:
@@ -216,9 +225,18 @@ class Translator:
             constrained: Decode under the grammar (variant C).
             sampling: Draw the answer (seeded) instead of decoding greedily; see
                 :mod:`ara.eval.consistency`.
+            require: With ``constrained``: literals the answer must write, each a
+                proposition of ``aps`` or a bound the grammar admits (e.g.
+                ``("prop_3", "10")``); see :func:`~ara.grammars.require_literals`.
+
+        Raises:
+            ConfigError: If ``require`` names a literal the request's grammar never
+                writes.
         """
         aps = tuple(aps)
         built = self.grammar(aps, nl)
+        if require and constrained:
+            built = _requiring(built, tuple(require))
         shown = grammar_for_prompt(built.syntax) if grammar_in_prompt else None
         prompt = build_prompt(nl, aps, shots, shown)
         if constrained:

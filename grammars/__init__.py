@@ -25,6 +25,7 @@ from ara.grammars.ast import (
 )
 from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
+from ara.grammars.required_literals import require_literals
 from ara.grammars.stl_grammar import BuiltGrammar, build_grammar
 from ara.grammars.syntax import GRAMMAR_VERSION, Syntax
 
@@ -51,6 +52,7 @@ __all__ = [
     "depth",
     "max_bound",
     "parse",
+    "require_literals",
     "to_text",
     "walk",
 ]

@@ -89,6 +89,7 @@ MODELS = {
     "soup-s-v19-270m": ("soup (v16+v17)+v19 at rank 16", ("compositional", "e910409c3f2c")),
     "soup-s-v19-v20-270m": ("soup (v16+v17)+v19+v20 at rank 16",
                             ("compositional", "e910409c3f2c")),
+    "soup-s-v20-270m": ("soup (v16+v17)+v20 at rank 16", ("compositional", "e910409c3f2c")),
     "soup-v16v17-repair8-270m": ("soup v16+v17 (shipped), repair 8",
                                  ("compositional", "89be643cc979")),
     "soup-v16v18-270m": ("soup v16+v18 at rank 16", ("compositional", "e910409c3f2c")),

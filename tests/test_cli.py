@@ -12,6 +12,8 @@ from typer.testing import CliRunner
 
 from ara.cli import app
 
+from conftest import needs_llama
+
 ARA = [str(Path(sys.executable).with_name("ara"))]
 runner = CliRunner()
 
@@ -179,3 +181,17 @@ def test_translate_refuses_a_request_it_cannot_honour(args, message):
     """Tests that bad translation requests exit 2 with the fix, before any model loads."""
     out = ara("translate", *args)
     assert out.returncode == 2 and message in out.stderr and "Traceback" not in out.stderr
+
+
+@needs_llama
+def test_translate_warns_when_the_answer_leaves_part_of_the_request_out():
+    """Tests the warning and the JSON field on a request no answer can cover: without
+    intervals, nothing can write the 5 the sentence states."""
+    args = ["reach (prop_1) within 5 steps", "--aps", "prop_1", "--no-intervals",
+            "--repair", "0"]
+    out = ara("translate", *args)
+    assert out.returncode == 0 and "prop_1" in out.stdout
+    assert "warning: this answer never uses the bound 5 the sentence states" in out.stderr
+    out = ara("translate", *args, "--json")
+    assert json.loads(out.stdout)["left_out"] == {"aps": [], "numbers": [5]}
+    assert "warning" not in out.stderr  # JSON users read the field

@@ -8,7 +8,7 @@ from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
 from ara.eval.consistency import _group, rank_repairs, translate_consistent, translate_repaired
 from ara.eval.coverage import gaps
-from ara.eval.translator import Translator
+from ara.eval.translator import Translator, TranslatorConfig
 from ara.grammars import parse
 
 from conftest import needs_llama
@@ -87,3 +87,15 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
     with pytest.raises(ConfigError, match="samples must be >= 0"):
         translate_repaired(t, nl, aps, samples=-1)
+
+
+@needs_llama
+def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
+    """Tests that without intervals a stated bound is no reason to draw: no answer of
+    the grammar could write it."""
+    t = Translator(llama_backend, TranslatorConfig(intervals=False))
+    nl, aps = "reach (prop_1) within 5 steps", ("prop_1",)
+    vote = translate_repaired(t, nl, aps, samples=3)
+    left_out = gaps(nl, aps, parse(vote.answers[0]))
+    assert left_out.numbers == (5,)
+    assert len(vote.results) == (4 if left_out.aps else 1)

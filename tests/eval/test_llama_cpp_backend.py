@@ -5,6 +5,7 @@ import random
 import numpy as np
 import pytest
 
+from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError
 from ara.eval.backends.masking import allowed_tokens
 from ara.eval.prompt import STOP, build_prompt, sample_shots
@@ -64,6 +65,26 @@ def test_constrained_timed_outputs_respect_interval_bounds(llama_backend):
         syntax = translator.config.syntax(("prop_1", "prop_2"))
         assert syntax.intervals and syntax.max_bound == 60
         assert result.valid and syntax.accepts(result.stl), result
+
+
+def test_an_answer_can_be_required_to_write_what_the_request_lists(llama_backend):
+    """Tests ``require`` on real generations: every answer names the required
+    proposition and bound, and stays in the request's language."""
+    from ara.grammars import atoms, parse, walk
+    from ara.grammars.ast import interval_of
+
+    translator = Translator(llama_backend)
+    nl = "reach (prop_1) within 12 steps, and never (prop_2) or (prop_3)"
+    aps = ("prop_1", "prop_2", "prop_3")
+    for require in (("prop_3",), ("prop_2", "12")):
+        result = translator.translate(nl, aps, require=require)
+        formula = parse(result.stl)
+        bounds = {str(b) for node in walk(formula) if (iv := interval_of(node))
+                  for b in (iv.lo, iv.hi)}
+        assert set(require) <= atoms(formula) | bounds, result.stl
+        assert translator.config.syntax(aps, nl).accepts(result.stl)
+    with pytest.raises(ConfigError, match="cannot require 7"):  # not a bound of the sentence
+        translator.translate(nl, aps, require=("7",))
 
 
 def test_prefix_reuse_changes_nothing_but_the_work(llama_backend, embedded_model_path,
