@@ -118,12 +118,21 @@ def _own_order(world: GridWorld, h: Helper) -> list[str]:
 def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
     aps = tuple(errand.places)
     echo(f"[instruction] {errand.nl}")
+    warning = None
     if translator is None:
         stl, source = errand.reference, "reference"
     else:
-        result = translator.translate(errand.nl, aps, constrained=True)
+        from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
+        from ara.eval.coverage import gaps
+
+        # Repaired as `ara translate` repairs, so the demo shows what a user would get
+        result = translate_repaired(translator, errand.nl, aps, samples=DEFAULT_REPAIR).result
         stl, source = result.stl, f"translated by {translator.backend.model_id}"
+        if gap := gaps(errand.nl, aps, parse(stl)):
+            warning = gap.warning()
     echo(f"[STL, {source}] {stl}")
+    if warning:
+        echo(warning)
     vocab = Vocabulary(errand.places)
     try:
         plan = plan_spec(world, errand.start, {"task": parse(stl)}, vocab, "makespan")
@@ -178,7 +187,8 @@ def draw(world: GridWorld, paths: dict[str, list[Cell]], target: Path, title: st
     ax.set_yticks(range(world.rows))
     ax.grid(True, lw=0.3)
     ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
+    if any(paths.values()):  # a request with no plan draws the world alone
+        ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     fig.savefig(target, dpi=110)
     plt.close(fig)

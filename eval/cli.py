@@ -10,6 +10,7 @@ import typer
 
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
+from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -17,10 +18,6 @@ eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
 MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lora:ADAPTER.gguf "
               "(another LoRA on the same base), a .gguf path, hf:FOLDER, or an "
               "OpenAI-compatible http(s):// endpoint")
-#: Extra answers ``ara translate`` draws when the greedy one leaves part of the request out:
-#: on the held-out sets this fixed 4 of 559 answers and lost none, drawing for 3% of them
-#: (docs/generalization.md#repair-answers-that-leave-part-of-the-request-out).
-REPAIR = 8
 
 SERVER_HELP = ("With an http(s):// --model: the server that runs it, which says where it reads "
                "the grammar for constrained decoding: llama (llama.cpp, llama-cpp-python), "
@@ -121,18 +118,9 @@ def translate_cmd(
         gap = gaps(nl, names, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
         if gap and not as_json:
-            typer.echo(left_out_warning(gap), err=True)
+            typer.echo(gap.warning(), err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
 
-
-def left_out_warning(gap) -> str:
-    """What to tell a user whose answer leaves part of the request out: such answers
-    were wrong 17 times in 18 on the held-out sets, so it should not pass silently."""
-    parts = [*(f"{ap} (in --aps)" for ap in gap.aps),
-             *(f"the bound {n} the sentence states" for n in gap.numbers)]
-    return (f"warning: this answer never uses {', '.join(parts)}, so it most likely "
-            "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
-            "sentence, or a larger --repair, may help.")
 
 
 @eval_app.command("ablation")

@@ -41,6 +41,15 @@ class Gaps:
     def __len__(self) -> int:
         return len(self.aps) + len(self.numbers)
 
+    def warning(self) -> str:
+        """What to tell a user whose answer leaves these out: such answers were nearly
+        always wrong on the held-out sets, so it should not pass silently."""
+        parts = [*(f"{ap}, a listed proposition," for ap in self.aps),
+                 *(f"the bound {n} the sentence states" for n in self.numbers)]
+        return (f"warning: this answer never uses {' or '.join(parts)}, so it most likely "
+                "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
+                "sentence may help.")
+
 
 def stated_numbers(nl: str, aps: Sequence[str]) -> frozenset[int]:
     """The numbers ``nl`` states as time: every number in digits, and a number word

@@ -1,0 +1,30 @@
+"""`ara demo` with a translator: the errand is translated as `ara translate` would."""
+
+import json
+
+import pytest
+
+from ara.coordination.demos import ERRANDS, run_demo
+from ara.eval.coverage import gaps
+from ara.eval.models import FINETUNED_LORA, make_backend
+from ara.eval.translator import Translator
+from ara.grammars import parse
+
+from conftest import needs_llama
+
+
+@needs_llama
+@pytest.mark.parametrize("name", ["kitting", "tool"])
+def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path):
+    """Tests the demo's translation path: the formula it plans from is the repaired
+    translation, and a warning names anything it still leaves out."""
+    if not FINETUNED_LORA.is_file():
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
+    lines = []
+    result = run_demo(name, tmp_path, Translator(make_backend("finetuned")), lines.append)
+    errand = ERRANDS[name]
+    assert result["source"].startswith("translated by gguf:")
+    assert any(line.startswith("[STL, translated by") for line in lines)
+    left_out = gaps(errand.nl, tuple(errand.places), parse(result["stl"]))
+    assert any(line.startswith("warning:") for line in lines) == bool(left_out)
+    assert json.loads((tmp_path / f"{name}.json").read_text())["stl"] == result["stl"]
