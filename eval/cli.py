@@ -11,6 +11,7 @@ import typer
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
 from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
+from ara.eval.consistency import translate_consistent, translate_repaired
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -18,7 +19,6 @@ eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
 MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lora:ADAPTER.gguf "
               "(another LoRA on the same base), a .gguf path, hf:FOLDER, or an "
               "OpenAI-compatible http(s):// endpoint")
-
 SERVER_HELP = ("With an http(s):// --model: the server that runs it, which says where it reads "
                "the grammar for constrained decoding: llama (llama.cpp, llama-cpp-python), "
                "vllm, sglang, or openai (no grammar; constrained variants are refused).")
@@ -93,14 +93,10 @@ def translate_cmd(
         translator = Translator(make_backend(model, server=server), config)
         vote = None
         if samples > 1:
-            from ara.eval.consistency import translate_consistent
-
             vote = translate_consistent(translator, nl, names, examples, samples, temperature,
                                         seed, grammar_in_prompt=grammar_in_prompt)
             result = vote.result
         elif repair:
-            from ara.eval.consistency import translate_repaired
-
             vote = translate_repaired(translator, nl, names, examples, repair, temperature,
                                       seed, grammar_in_prompt=grammar_in_prompt)
             result = vote.result
@@ -120,7 +116,6 @@ def translate_cmd(
         if gap and not as_json:
             typer.echo(gap.warning(), err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
-
 
 
 @eval_app.command("ablation")

@@ -83,7 +83,7 @@ def _require_one(grammar: Grammar, text: str) -> Grammar:
             inner = with_it(item.items, owner)
             if not inner:
                 return []
-            middle = inner[0] if len(inner) == 1 else (Ref(_helper(owner, inner)),)
+            middle = inner[0] if len(inner) == 1 else (Ref(helper(owner, inner)),)
             if isinstance(item, Opt):
                 return [middle]
             skipped = without(item.items)
@@ -91,7 +91,7 @@ def _require_one(grammar: Grammar, text: str) -> Grammar:
             return [(*head, *middle, item)]
         return []
 
-    def _helper(owner: str, alts: list[Seq]) -> str:
+    def helper(owner: str, alts: list[Seq]) -> str:
         name = fresh(f"{owner}_part")
         helpers.append(Rule(name, tuple(alts)))
         return name
@@ -104,8 +104,7 @@ def _require_one(grammar: Grammar, text: str) -> Grammar:
         marked = tuple(s for a in rule.alts for s in with_it(a, has_name[rule.name]))
         rules.append(Rule(not_name[rule.name], plain))
         rules.append(Rule(has_name[rule.name], marked))
-    root = Rule(fresh(f"{grammar.root}_with"), ((Ref(has_name[grammar.root]),),))
-    return _pruned([root, *rules, *helpers], root.name)
+    return _pruned([*rules, *helpers], has_name[grammar.root])
 
 
 def _rules_reaching(grammar: Grammar, marker: Lit) -> set[str]:
