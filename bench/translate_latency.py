@@ -11,9 +11,9 @@ under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one w
 call first. A formula's time depends on its length, so tokens per answer are shown too.
 Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
 with the default grammar, so a candidate is timed beside what ships, in the same run.
-``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`):
-its median is the greedy answer's, its mean carries the extra answers drawn for the
-few whose greedy answer leaves part of the request out.
+``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`), by
+edits (the default) and by samples: its median is the greedy answer's, its mean carries
+the extra work for the few whose greedy answer leaves part of the request out.
 """
 
 from __future__ import annotations
@@ -25,15 +25,16 @@ import random
 import statistics
 
 from ara.data import load_or_prepare
-from ara.eval.consistency import translate_repaired
+from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator, TranslatorConfig
 
 
-def measure(translator: Translator, records, repair: int = 0) -> dict:
+def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0]) -> dict:
     translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
     if repair:
-        votes = [translate_repaired(translator, r.nl, r.aps, samples=repair) for r in records]
+        votes = [translate_repaired(translator, r.nl, r.aps, samples=repair, by=by)
+                 for r in records]
         runs, ms = [v.result for v in votes], [v.ms for v in votes]
     else:
         runs = [translator.translate(r.nl, r.aps) for r in records]
@@ -61,8 +62,9 @@ def main() -> None:
     rows = [("finetuned-paper", TranslatorConfig(intervals=False), "earlier default",
              "no time bounds", 0),
             ("finetuned", TranslatorConfig(), "default", "bounds the sentence writes", 0),
-            *([("finetuned", TranslatorConfig(), f"--repair {args.repair}",
-                "bounds the sentence writes", args.repair)] if args.repair else []),
+            *[("finetuned", TranslatorConfig(), f"--repair {args.repair} --repair-by {by}",
+               "bounds the sentence writes", (args.repair, by))
+              for by in REPAIR_BY if args.repair],
             ("finetuned", TranslatorConfig(bounds_from_request=False), "--any-bound",
              "any bound up to 1000", 0),
             ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds",
@@ -72,7 +74,7 @@ def main() -> None:
     base = None
     for model, config, label, grammar, repair in rows:
         t = Translator(make_backend(model), config)
-        m = measure(t, records, repair)
+        m = measure(t, records, *(repair or (0,)))
         base = base or m["median_ms"]
         print(f"| {model} ({label}) | {grammar} | "
               f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {m['tokens']:.1f} | "

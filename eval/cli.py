@@ -11,7 +11,7 @@ import typer
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
 from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
-from ara.eval.consistency import translate_consistent, translate_repaired
+from ara.eval.consistency import REPAIR_BY, translate_consistent, translate_repaired
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -57,9 +57,16 @@ def translate_cmd(
     repair: int | None = typer.Option(
         None, "--repair", min=0, max=32,
         help=f"When the greedy answer leaves out a proposition in --aps or a number the "
-             f"sentence states as time, draw K more under the grammar and keep the majority "
-             f"of those that leave out least (a complete greedy answer costs nothing more). "
-             f"Default {REPAIR}, or 0 with --samples; 0: off."),
+             f"sentence states as time, look for an answer that leaves out less (a "
+             f"complete greedy answer costs nothing more), drawing K answers under the "
+             f"grammar (see --repair-by). Default {REPAIR}, or 0 with --samples; 0: off."),
+    repair_by: str = typer.Option(
+        REPAIR_BY[0], "--repair-by",
+        help="samples+edits: the K answers drawn and the formulas one edit from the "
+             "greedy answer that write what it left out; the one the model scores "
+             "highest of those that leave out least wins. edits: the edits alone. "
+             "samples: the majority of the K drawn that leave out least (also what the "
+             "others do with an HTTP --model, which cannot score)."),
     server: str = typer.Option("openai", "--server", help=SERVER_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
@@ -85,6 +92,8 @@ def translate_cmd(
                               "pass one")
         if repair and no_constraint:
             raise ConfigError("--repair decodes under the grammar; drop --no-constraint")
+        if repair_by not in REPAIR_BY:
+            raise ConfigError(f"--repair-by {repair_by!r}? choose one of {', '.join(REPAIR_BY)}")
         if repair is None:
             repair = 0 if samples > 1 or no_constraint else REPAIR
         k = shots if shots is not None else default_shots(model)
@@ -98,7 +107,7 @@ def translate_cmd(
             result = vote.result
         elif repair:
             vote = translate_repaired(translator, nl, names, examples, repair, temperature,
-                                      seed, grammar_in_prompt=grammar_in_prompt)
+                                      seed, grammar_in_prompt=grammar_in_prompt, by=repair_by)
             result = vote.result
         else:
             result = translator.translate(nl, names, examples, grammar_in_prompt,
@@ -110,6 +119,9 @@ def translate_cmd(
     if vote is not None:
         data["samples"] = {"answers": list(vote.answers), "groups": [list(g) for g in vote.groups],
                            "agreement": round(vote.agreement, 3)}
+        if vote.scores:
+            data["samples"]["scores"] = [None if x is None else round(x, 3)
+                                         for x in vote.scores]
     if result.stl is not None:
         gap = gaps(nl, names, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
@@ -148,8 +160,13 @@ def ablation_cmd(
     repair: int = typer.Option(
         0, "--repair", min=0, max=32,
         help="Constrained variants: when the greedy answer leaves out a listed proposition "
-             "or a number the sentence states, draw K more under the grammar and keep the "
-             "majority of those that leave out least. 0 (the paper's variants): greedy."),
+             "or a number the sentence states, look for an answer that leaves out less, "
+             "drawing K more (see --repair-by). 0 (the paper's variants): greedy."),
+    repair_by: str = typer.Option(
+        REPAIR_BY[0], "--repair-by",
+        help="samples+edits (the model's best-scored of the K drawn and the greedy "
+             "answer's one-edit mends), edits (the mends alone) or samples (the majority "
+             "of the K drawn)."),
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import run_ablation
@@ -164,6 +181,7 @@ def ablation_cmd(
             split=split, form=form, variants=split_list(variants),
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
+            repair_by=repair_by,
         )
         backend = make_backend(model, mask=mask, server=server)
         try:

@@ -6,30 +6,37 @@ all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
 greedy answer, so with one sample this is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
 
-Repair (:func:`translate_repaired`) draws the extra answers only when the greedy one
+Repair (:func:`translate_repaired`) looks for another answer only when the greedy one
 leaves out a listed proposition or a stated bound (:mod:`ara.eval.coverage`), and then
-prefers the answers that leave out least; the greedy answer stays unless a sample
-says more of the request. On a complete greedy answer it costs nothing.
+prefers the answers that leave out least; the greedy answer stays unless another says
+more of the request. By default the other answers are the formulas one edit from the
+greedy one that write what it left out, and the model's score of each whole answer
+picks among them; sampled answers are the fallback. On a complete greedy answer
+repair costs nothing.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
 from ara.eval.coverage import gaps
 from ara.eval.prompt import Shot
-from ara.eval.translator import TranslationResult, Translator
-from ara.grammars import parse
+from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
+from ara.grammars import parse, to_text
+from ara.grammars.literal_edits import literal_edits
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
-#: Extra answers ``ara translate`` and ``ara demo`` draw when the greedy one leaves part of
-#: the request out: on the held-out sets this fixed 4 of 559 answers and lost none,
-#: drawing for 3% of them (docs/generalization.md, "Repair").
+#: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
+#: samples+edits it fixed 8 of 473 held-out greedy answers and lost none, acting on 18
+#: (by samples alone 4; docs/generalization.md, "Repair by the model's score").
 DEFAULT_REPAIR = 8
+
+#: How repair looks for a better answer (see :func:`translate_repaired`).
+REPAIR_BY = ("samples+edits", "edits", "samples")
 
 
 @dataclass(frozen=True)
@@ -40,11 +47,14 @@ class Vote:
         results: Every translation, greedy first.
         groups: Indices into ``results``, one tuple per meaning, largest first.
         ms: Wall time of all generations and checks.
+        scores: The model's log-probability of each answer, where answers were scored
+            (repair by edits: those that leave out least); ``None`` for the others.
     """
 
     results: tuple[TranslationResult, ...]
     groups: tuple[tuple[int, ...], ...]
     ms: float
+    scores: tuple[float | None, ...] = ()
 
     @property
     def result(self) -> TranslationResult:
@@ -91,35 +101,80 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
 def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
                        shots: Sequence[Shot] = (), samples: int = 8,
                        temperature: float = 0.7, seed: int = 0, timeout_s: float = 10.0,
-                       grammar_in_prompt: bool = False) -> Vote:
-    """Translate ``nl`` greedily; if the answer leaves out part of the request, draw
-    ``samples`` more under the grammar and keep the majority meaning among those that
-    leave out least.
+                       grammar_in_prompt: bool = False, by: str = "samples+edits") -> Vote:
+    """Translate ``nl`` greedily; if the answer leaves out part of the request, look for
+    one that leaves out less.
 
     Args:
         translator, nl, aps, shots, temperature, timeout_s, grammar_in_prompt: As
             :func:`translate_consistent`.
         samples: Extra answers to draw when the greedy one has a gap, >= 0 (0: greedy).
         seed: Extra answer ``i`` (from 1) is drawn with seed ``seed + i``.
+        by: ``samples+edits``: draw ``samples`` answers under the grammar, add the
+            formulas one edit from the greedy answer that write what it left out
+            (:func:`literal_mends`), and keep the model's best-scored answer among
+            those that leave out least. ``edits``: the same without the samples
+            (drawn only if no edit fits the request's grammar). ``samples``: keep the
+            majority meaning among the samples that leave out least, which is also
+            what the other two do where the backend cannot score.
 
     Returns:
-        A :class:`Vote` of one answer when the greedy one leaves nothing out or
-        ``samples`` is 0; otherwise of all, greedy first. The greedy answer wins unless
-        a sample leaves out less.
+        A :class:`Vote` of one answer when the greedy one leaves nothing out,
+        ``samples`` is 0, or the backend can neither score nor sample (an HTTP
+        server); otherwise of all answers considered, greedy first. The
+        greedy answer wins unless another leaves out less. Scored answers form one
+        group each, best score first; a mended answer's result is the greedy one's
+        with the formula replaced (timings and token counts are the greedy call's).
     """
     if samples < 0:
         raise ConfigError(f"samples must be >= 0, got {samples}")
+    if by not in REPAIR_BY:
+        raise ConfigError(f"repair by {by!r}? choose one of {', '.join(REPAIR_BY)}")
     start = time.perf_counter()
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
-    results = [greedy]
     # Without intervals no answer can write a bound: only propositions can be mended.
     bounds = translator.config.intervals
-    if samples and 0 < _missing(nl, aps, greedy.stl, bounds) < float("inf"):
-        results += _draw(translator, nl, aps, shots, samples, temperature, seed,
-                         grammar_in_prompt)
+    gap = _missing(nl, aps, greedy.stl, bounds)
+    helpless = not can_score(translator) and not getattr(translator.backend, "can_sample", True)
+    if not samples or not 0 < gap < float("inf") or helpless:
+        return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
+    if by != "samples" and can_score(translator):
+        drawn = (_draw(translator, nl, aps, shots, samples, temperature, seed,
+                       grammar_in_prompt) if by == "samples+edits" else [])
+        mends = literal_mends(translator, nl, aps, greedy.stl, bounds)
+        if drawn or mends:
+            results = [greedy, *drawn, *(replace(greedy, raw=ANSWER_PREFIX + text, stl=text)
+                                         for text in mends)]
+            missing = [_missing(nl, aps, r.stl, bounds) for r in results]
+            scores = _scores(translator, nl, aps, shots, grammar_in_prompt, results, missing)
+            # As with samples, the greedy answer stays unless another leaves out less.
+            stays = missing[0] == min(missing)
+            order = sorted(range(len(results)), key=lambda i: (
+                scores[i] is None, not (stays and i == 0), -(scores[i] or 0)))
+            return Vote(tuple(results), tuple((i,) for i in order),
+                        (time.perf_counter() - start) * 1e3, tuple(scores))
+    results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
+                              grammar_in_prompt)]
     ranked = rank_repairs([r.stl for r in results],
                           [_missing(nl, aps, r.stl, bounds) for r in results], timeout_s)
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
+
+
+def _scores(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],
+            grammar_in_prompt: bool, results: Sequence[TranslationResult],
+            missing: Sequence[float]) -> list[float | None]:
+    """The model's score of each answer that leaves out least (``None`` for the rest);
+    an answer given twice is scored once."""
+    pool = sorted({r.stl for r, m in zip(results, missing, strict=True) if m == min(missing)})
+    scored = dict(zip(pool, translator.score(nl, aps, [parse(t) for t in pool], shots,
+                                             grammar_in_prompt), strict=True))
+    return [scored[r.stl] if m == min(missing) else None
+            for r, m in zip(results, missing, strict=True)]
+
+
+def can_score(translator: Translator) -> bool:
+    """Whether the translator's backend can score answers (the local ones can)."""
+    return callable(getattr(translator.backend, "score", None))
 
 
 def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
@@ -140,6 +195,17 @@ def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
         ranked = _group(best, timeout_s)
         ranked.sort(key=lambda g: (missing[g[0]] != least, -len(g), g[0]))
     return ranked
+
+
+def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
+                  bounds: bool = True) -> list[str]:
+    """Formulas one edit from ``stl`` that write something it leaves out of the request
+    (:func:`~ara.grammars.literal_edits.literal_edits`), kept to the request's language
+    so that each is an answer constrained decoding could have given."""
+    gap = gaps(nl, aps, parse(stl))
+    syntax = translator.grammar(aps, nl).syntax
+    edits = literal_edits(parse(stl), gap.aps, gap.numbers if bounds else ())
+    return [text for text in map(to_text, edits) if syntax.accepts(text)]
 
 
 def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],

@@ -20,7 +20,7 @@ from ara import __version__
 from ara.data import PreparedSplit, Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
-from ara.eval.consistency import translate_repaired
+from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
@@ -77,9 +77,14 @@ class AblationConfig:
         spot_timeout_s: Time limit per Spot check; past it the pair counts as undecided.
         translator: Grammar and budget settings.
         repair: With C: when the greedy answer leaves out a listed proposition or a
-            stated bound, draw this many more (seeded, T=0.7) and keep the majority of
-            those that leave out least (:func:`~ara.eval.consistency.translate_repaired`);
-            0 (the paper's variants): greedy only.
+            stated bound, look for one that leaves out less
+            (:func:`~ara.eval.consistency.translate_repaired`): the number of answers to
+            draw where sampling is the way (seeded, T=0.7); 0 (the paper's variants):
+            greedy only.
+        repair_by: ``samples+edits`` (the model's best-scored of the answers drawn and
+            the greedy answer's one-edit mends), ``edits`` (the mends alone) or
+            ``samples`` (the majority of those drawn; also the others' way where the
+            backend cannot score).
     """
 
     split: str = "paper"
@@ -94,6 +99,7 @@ class AblationConfig:
     spot_timeout_s: float = 10.0
     translator: TranslatorConfig = field(default_factory=TranslatorConfig)
     repair: int = 0
+    repair_by: str = REPAIR_BY[0]
 
     def __post_init__(self) -> None:
         if self.split not in SPLITS:
@@ -113,12 +119,15 @@ class AblationConfig:
                 f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
                 f"limit={self.limit}, repair={self.repair}"
             )
+        if self.repair_by not in REPAIR_BY:
+            raise ConfigError(f"repair by {self.repair_by!r}? choose one of "
+                              f"{', '.join(REPAIR_BY)}")
 
     def to_dict(self) -> dict:
         data = asdict(self)
         data["variants"], data["shots"] = list(self.variants), list(self.shots)
         if not self.repair:  # as runs from before repair existed wrote it: they resume
-            del data["repair"]
+            del data["repair"], data["repair_by"]
         return data
 
     @classmethod
@@ -128,6 +137,8 @@ class AblationConfig:
         if unknown:
             raise ConfigError(f"unknown keys {sorted(unknown)}; known: {sorted(known)}")
         data = dict(data)
+        if data.get("repair") and "repair_by" not in data:
+            data["repair_by"] = "samples"  # repaired before repair by edits existed
         data["variants"], data["shots"] = tuple(data["variants"]), tuple(data["shots"])
         data["translator"] = TranslatorConfig(**data.get("translator", {}))
         return cls(**data)
@@ -218,12 +229,14 @@ class Answer:
         return self.result.ms if self.ms is None else self.ms
 
 
-def translate_job(translator: Translator, job: Job, repair: int = 0) -> Answer:
+def translate_job(translator: Translator, job: Job, repair: int = 0,
+                  repair_by: str = REPAIR_BY[0]) -> Answer:
     """The generation of one job (what may run concurrently against a server)."""
     r = job.record
     if repair and job.variant.constrained:
         vote = translate_repaired(translator, r.nl, r.aps, job.examples, samples=repair,
-                                  grammar_in_prompt=job.variant.grammar_in_prompt)
+                                  grammar_in_prompt=job.variant.grammar_in_prompt,
+                                  by=repair_by)
         return Answer(vote.result, len(vote.results), vote.ms)
     return Answer(translator.translate(r.nl, r.aps, job.examples,
                                        job.variant.grammar_in_prompt, job.variant.constrained))

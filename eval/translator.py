@@ -15,9 +15,17 @@ from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 
 from ara.errors import AraError, ConfigError, STLSyntaxError
-from ara.eval.backends.base import Backend, Sampling
+from ara.eval.backends.base import Backend, BackendError, Sampling
 from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
-from ara.grammars import BuiltGrammar, Syntax, build_grammar, parse, require_literals, to_text
+from ara.grammars import (
+    BuiltGrammar,
+    Formula,
+    Syntax,
+    build_grammar,
+    parse,
+    require_literals,
+    to_text,
+)
 
 #: The space a model writes after "STL:"; part of the decoding grammar, stripped after.
 ANSWER_PREFIX = " "
@@ -265,6 +273,22 @@ class Translator:
             masked_steps=completion.masked_steps,
             grammar=built.provenance() if constrained else {},
         )
+
+    def score(self, nl: str, aps: Sequence[str], formulas: Sequence[Formula],
+              shots: Sequence[Shot] = (), grammar_in_prompt: bool = False) -> list[float]:
+        """The model's log-probability of each formula as the answer to ``nl``, written
+        as decoding would write it (canonical text, then the end of the answer).
+
+        Raises:
+            BackendError: If the backend cannot score (an HTTP server).
+        """
+        score = getattr(self.backend, "score", None)
+        if score is None:
+            raise BackendError(f"{type(self.backend).__name__} cannot score answers; "
+                               "use a local model (llama.cpp or transformers)")
+        shown = grammar_for_prompt(self.grammar(aps, nl).syntax) if grammar_in_prompt else None
+        prompt = build_prompt(nl, tuple(aps), shots, shown)
+        return score(prompt, [ANSWER_PREFIX + to_text(f) + STOP for f in formulas])
 
     @staticmethod
     def _check_guarantee(built: BuiltGrammar, raw: str, stop: str) -> None:

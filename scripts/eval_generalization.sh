@@ -10,8 +10,9 @@
 # shapes and phrasings, 50 lifted + 50 grounded), timed (NL2TL's lifted dev file, 100),
 # paper and disjoint (100 lifted each); $LIMIT overrides the sampled sizes. Variants: $VARIANTS (default none,C,F+C; C,F+C on
 # paper and disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
-# Spot's limit 5 s a pair (undecided counts as wrong); $REPAIR (default 0) extra answers
-# when a constrained answer leaves part of the request out (`ara eval ablation --repair`).
+# Spot's limit 5 s a pair (undecided counts as wrong); $REPAIR (default 0) turns repair on
+# when a constrained answer leaves part of the request out (`ara eval ablation --repair`,
+# $REPAIR answers drawn where sampling is the way), by $REPAIR_BY (default samples+edits).
 # Each run resumes from its samples.
 # `scripts/generalization_table.py` prints the table from what is there.
 set -euo pipefail
@@ -26,7 +27,7 @@ out=docs/results/generalization/$name
 run() {  # SPLIT FORM LIMIT [VARIANTS]
   .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \
     --variants "${4:-$variants}" --shots 5 --reruns 1 --seed 0 --spot-timeout 5 --resume \
-    --repair "${REPAIR:-0}" \
+    --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" \
     --no-progress --out "$out/$1-$2" > /dev/null
   echo "done: $name $1 $2"
 }

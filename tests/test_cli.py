@@ -175,6 +175,8 @@ def test_explain_reads_a_formula_back_in_english():
         (["reach prop_1 within 5000 steps", "--aps", "prop_1"], "pass --max-bound 5000"),
         (["always (prop_1)", "--aps", "prop_1", "--samples", "3", "--repair", "2"],
          "pass one"),
+        (["always (prop_1)", "--aps", "prop_1", "--repair-by", "votes"],
+         "--repair-by 'votes'? choose one of samples+edits, edits, samples"),
     ],
 )
 def test_translate_refuses_a_request_it_cannot_honour(args, message):

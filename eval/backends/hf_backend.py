@@ -14,12 +14,13 @@ one from the embedded GGUF) or a hub id already in the local cache. Nothing down
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ara.eval.backends.base import BackendError, Completion, Sampling
-from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
+from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
 from ara.grammars import BuiltGrammar
 from ara.kv_cache import cache_of, with_cache
 
@@ -132,6 +133,27 @@ class HFBackend:
             self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
         return Completion(text, len(ids), len(out), reused, (time.perf_counter() - start) * 1e3,
                           reason, matcher.masked_steps if matcher else 0)
+
+    def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
+        """Log-probability of each continuation after ``prompt``, teacher-forced without a
+        grammar (see :func:`~ara.eval.backends.masking.score_paths`)."""
+        ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
+        paths = [self.tokenizer(c, add_special_tokens=False)["input_ids"] for c in continuations]
+        self._feed_prompt(ids)
+        return score_paths(ids, paths, self._rows)
+
+    def _rows(self, start: int, tokens: list[int]) -> np.ndarray:
+        """Scores after each of ``tokens``, fed after the first ``start`` cached ones."""
+        torch = self._torch
+        if start < len(self._cached_ids):  # crop(0) would empty the cache
+            self._cache.crop(start - len(self._cached_ids))
+            self._cached_ids = self._cached_ids[:start]
+        with torch.inference_mode():
+            out = self.model(input_ids=torch.tensor([tokens], device=self.device),
+                             use_cache=True, **with_cache(self._cache))
+        self._cache = cache_of(out)
+        self._cached_ids += tokens
+        return out.logits[0].float().cpu().numpy()
 
     def _complete_outlines(self, prompt: str, grammar: BuiltGrammar,
                            max_tokens: int) -> Completion:

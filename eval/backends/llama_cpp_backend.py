@@ -16,12 +16,13 @@ from __future__ import annotations
 import os
 import time
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ara.eval.backends.base import BackendError, Completion, Sampling
-from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode
+from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
 from ara.eval.llama_check import muted_llama_log
 from ara.grammars import BuiltGrammar
 from ara.provenance import sha256_file
@@ -131,6 +132,37 @@ class LlamaCppBackend:
         return Completion(text, len(tokens), len(out), reused,
                           (time.perf_counter() - start) * 1e3, reason,
                           matcher.masked_steps if matcher else 0)
+
+    def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
+        """Log-probability of each continuation after ``prompt``, teacher-forced without a
+        grammar (see :func:`~ara.eval.backends.masking.score_paths`)."""
+        tokens = self.llm.tokenize(prompt.encode(), add_bos=True, special=False)
+        paths = [self.llm.tokenize(c.encode(), add_bos=False, special=False)
+                 for c in continuations]
+        longest = max(map(len, paths), default=0)
+        if len(tokens) + longest > self.llm.n_ctx() or longest > self.llm.n_batch:
+            raise BackendError(f"prompt of {len(tokens)} tokens + {longest} to score exceeds "
+                               f"the context of {self.llm.n_ctx()} or a batch of "
+                               f"{self.llm.n_batch}")
+        self._feed_prompt(tokens)
+        return score_paths(tokens, paths, self._rows)
+
+    def _rows(self, start: int, tokens: list[int]) -> np.ndarray:
+        """Scores after each of ``tokens``, fed at position ``start`` in one batch.
+
+        ``Llama.eval`` keeps only the last position's scores unless the whole context
+        was made with ``logits_all`` (a vocabulary-wide row per context position,
+        gigabytes here), so this asks llama.cpp for every row of this one batch only.
+        """
+        llm = self.llm
+        llm.n_tokens = start
+        llm._ctx.kv_cache_seq_rm(-1, start, -1)
+        llm._batch.set_batch(batch=tokens, n_past=start, logits_all=True)
+        llm._ctx.decode(llm._batch)
+        llm.input_ids[start: start + len(tokens)] = tokens
+        llm.n_tokens = start + len(tokens)
+        return np.ctypeslib.as_array(llm._ctx.get_logits(),
+                                     shape=(len(tokens), llm.n_vocab())).copy()
 
     def _complete_llama_grammar(self, grammar: BuiltGrammar, max_tokens: int, n_prompt: int,
                                 reused: int, start: float) -> Completion:

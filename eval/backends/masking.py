@@ -6,11 +6,14 @@ logits costs more than that in numpy; most steps need neither. Sample-then-check
 take the unconstrained argmax, ask the matcher whether it may follow; only when it
 may not, compute the mask and take the argmax over the allowed tokens. The result is
 exactly the masked greedy choice either way.
+
+The local backends also share their decoding loop (:func:`greedy_decode`) and the
+teacher-forced scoring of whole answers (:func:`score_paths`) from here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -103,6 +106,42 @@ def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
             return text[: text.index(stop)], out, "stop"
         logits = advance(token)
     return text, out, "length"
+
+
+def score_paths(prompt: Sequence[int], paths: Sequence[Sequence[int]],
+                rows: Callable[[int, list[int]], np.ndarray]) -> list[float]:
+    """Log-probability of each token path after ``prompt``, teacher-forced.
+
+    Paths go in sorted order, so each shares the longest prefix it can with the one
+    before it: that prefix's log-probabilities are kept, and only the rest is fed, in
+    one batch.
+
+    Args:
+        prompt: The prompt's token ids (at least one).
+        paths: Token ids of each continuation.
+        rows: ``rows(start, tokens)`` rolls the model back to its first ``start``
+            tokens of ``prompt + path``, feeds ``tokens`` from there, and returns the
+            scores after each of them (one row per token).
+    """
+    totals = [0.0] * len(paths)
+    done: list[int] = []
+    done_logp: list[float] = []
+    for i in sorted(range(len(paths)), key=lambda i: list(paths[i])):
+        path = list(paths[i])
+        shared = next((k for k, (a, b) in enumerate(zip(path, done, strict=False)) if a != b),
+                      min(len(path), len(done)))
+        logp = done_logp[:shared]
+        if shared < len(path):
+            # The scores for token ``shared`` come after feeding the one before it.
+            start = len(prompt) + shared - 1
+            feed = [*prompt, *path][start: len(prompt) + len(path) - 1]
+            for row, token in zip(rows(start, feed), path[shared:], strict=True):
+                row = row.astype(np.float64)
+                top = row.max()
+                logp.append(float(row[token] - top - np.log(np.exp(row - top).sum())))
+        totals[i] = sum(logp)
+        done, done_logp = path, logp
+    return totals
 
 
 @lru_cache(maxsize=256)

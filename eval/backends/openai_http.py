@@ -66,6 +66,10 @@ class OpenAIBackend:
         self.model, self.api, self.timeout_s, self.server = model, api, timeout_s, server
         self.model_id = f"http:{self.base_url}:{model}"
 
+    #: Seeded sampling under a grammar is not a call these servers share; repair reads
+    #: this and keeps the greedy answer instead of failing.
+    can_sample = False
+
     def _post(self, path: str, body: dict) -> dict:
         headers = {"Content-Type": "application/json"}
         if key := os.environ.get("OPENAI_API_KEY"):

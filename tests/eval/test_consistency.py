@@ -6,7 +6,13 @@ import pytest
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
-from ara.eval.consistency import _group, rank_repairs, translate_consistent, translate_repaired
+from ara.eval.consistency import (
+    _group,
+    literal_mends,
+    rank_repairs,
+    translate_consistent,
+    translate_repaired,
+)
 from ara.eval.coverage import gaps
 from ara.eval.translator import Translator, TranslatorConfig
 from ara.grammars import parse
@@ -78,15 +84,45 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     nl = "within 20 steps reach (prop_1), and never (prop_2)"
     greedy = t.translate(nl, aps)
     greedy_gaps = len(gaps(nl, aps, parse(greedy.stl)))
-    vote = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5)
+    vote = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
     assert vote.answers[0] == greedy.stl
     assert len(vote.results) == (4 if greedy_gaps else 1)
     assert len(gaps(nl, aps, parse(vote.result.stl))) <= greedy_gaps
-    again = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5)
+    again = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
     assert (again.answers, again.groups) == (vote.answers, vote.groups)
     assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
     with pytest.raises(ConfigError, match="samples must be >= 0"):
         translate_repaired(t, nl, aps, samples=-1)
+    with pytest.raises(ConfigError, match="choose one of samples\+edits, edits, samples"):
+        translate_repaired(t, nl, aps, by="votes")
+
+
+@needs_llama
+@pytest.mark.parametrize("by", ["samples+edits", "edits"])
+def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by):
+    """Tests repair by the model's score on an answer that leaves a bound out: it weighs
+    the greedy answer, the samples drawn (with samples+edits) and every formula one edit
+    away that writes what was left out; it scores exactly those that leave out least, as
+    the model scores each alone, and keeps the best."""
+    t = Translator(llama_backend)
+    aps = ("prop_1", "prop_2")
+    nl = "within 20 steps reach (prop_1), and never (prop_2)"
+    greedy = t.translate(nl, aps)
+    left_out = gaps(nl, aps, parse(greedy.stl))
+    if not left_out:
+        pytest.skip(f"the greedy answer {greedy.stl} leaves nothing out")
+    vote = translate_repaired(t, nl, aps, samples=3, by=by)
+    mends = literal_mends(t, nl, aps, greedy.stl)
+    drawn = 3 if by == "samples+edits" else 0
+    assert vote.answers[0] == greedy.stl and vote.answers[1 + drawn:] == tuple(mends)
+    missing = [len(gaps(nl, aps, parse(a))) for a in vote.answers]
+    scored = [i for i, x in enumerate(vote.scores) if x is not None]
+    assert scored == [i for i, m in enumerate(missing) if m == min(missing)]
+    winner = vote.groups[0][0]
+    assert winner in scored and vote.scores[winner] == max(vote.scores[i] for i in scored)
+    assert missing[winner] < len(left_out)
+    assert t.score(nl, aps, [parse(vote.result.stl)])[0] == pytest.approx(vote.scores[winner],
+                                                                         abs=0.2)
 
 
 @needs_llama

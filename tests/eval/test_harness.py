@@ -43,11 +43,22 @@ def test_config_round_trips_and_refuses_unknown_keys():
 def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
     """Tests that a run without repair writes the config runs wrote before repair
     existed (a resumed run must match it), and that repair round-trips and is bounded."""
-    assert "repair" not in AblationConfig().to_dict()
+    assert not {"repair", "repair_by"} & set(AblationConfig().to_dict())
     repaired = AblationConfig(repair=8)
     assert AblationConfig.from_dict(repaired.to_dict()) == repaired
+    assert repaired.repair_by == "samples+edits"
     with pytest.raises(ConfigError, match="repair from 0 to 32"):
         AblationConfig(repair=33)
+    with pytest.raises(ConfigError, match="choose one of samples\+edits, edits, samples"):
+        AblationConfig(repair=8, repair_by="votes")
+
+
+def test_a_run_repaired_before_edits_existed_reads_as_repaired_by_samples():
+    """Tests that a run folder written when repair only sampled keeps saying so, so that
+    resuming it with repair by edits is refused instead of mixing the two."""
+    old = AblationConfig(repair=8).to_dict()
+    del old["repair_by"]
+    assert AblationConfig.from_dict(old).repair_by == "samples"
 
 
 def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):

@@ -51,3 +51,14 @@ def test_unknown_model_is_a_clear_error(tmp_path):
 
     with pytest.raises(BackendError, match="cannot load"):
         HFBackend(str(tmp_path / "nothing-here"))
+
+
+def test_transformers_and_llama_cpp_score_answers_alike(hf_backend, llama_backend):
+    """Tests one model's two runtimes against each other: the same answers get nearly
+    the same log-probability (the HF folder is the GGUF's weights, dequantized)."""
+    prompt = build_prompt("always avoid the door and eventually reach the goal",
+                          ("door", "goal"), ())
+    answers = [" G(!door) & F(goal)\n", " F(goal) & G(!door)\n", " G(door)\n",
+               " G(!door) & F(door)\n"]
+    assert hf_backend.score(prompt, answers) == pytest.approx(
+        llama_backend.score(prompt, answers), abs=1.5)

@@ -123,3 +123,19 @@ def test_context_overflow_is_refused(llama_backend):
     """Tests the message when prompt plus budget exceed the context."""
     with pytest.raises(BackendError, match="exceeds the context"):
         llama_backend.complete("word " * 5000, None, 16, STOP)
+
+
+ANSWERS = (" G(!door) & F(goal)\n", " F(goal) & G(!door)\n", " G(door)\n", " G(!door) & F(door)\n")
+
+
+def test_scores_do_not_depend_on_what_else_is_scored(llama_backend):
+    """Tests that answers scored together (sharing a prefix, fed in batches) get what
+    each gets alone, in any order: log-probabilities, so below zero."""
+    prompt = build_prompt("always avoid the door and eventually reach the goal",
+                          ("door", "goal"), ())
+    together = llama_backend.score(prompt, ANSWERS)
+    assert together == llama_backend.score(prompt, ANSWERS[::-1])[::-1]
+    alone = [llama_backend.score(prompt, [a])[0] for a in ANSWERS]
+    assert together == pytest.approx(alone, abs=0.2)  # batch sizes round differently
+    assert all(x < 0 for x in together)
+    assert llama_backend.score(prompt, []) == []

@@ -62,6 +62,26 @@ def test_translator_parses_the_endpoint_answer(server):
     assert result.raw.strip() and (result.valid or result.error)
 
 
+def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
+    """Tests that scoring answers, which repair ranks by, is refused by name on a
+    server, and that repair, which can neither score nor sample there, keeps the
+    greedy answer of a request it would repair on a local model."""
+    from ara.eval.consistency import can_score, translate_repaired
+    from ara.eval.coverage import gaps
+    from ara.grammars import parse
+
+    translator = Translator(OpenAIBackend(server))
+    assert not can_score(translator)
+    with pytest.raises(BackendError, match="cannot score answers; use a local model"):
+        translator.score("eventually (prop_1)", ["prop_1"], [parse("F(prop_1)")])
+    nl, aps = "within 20 steps reach (prop_1), and never (prop_2)", ("prop_1", "prop_2")
+    greedy = translator.translate(nl, aps)
+    if not gaps(nl, aps, parse(greedy.stl)):
+        pytest.skip(f"the greedy answer {greedy.stl} leaves nothing out")
+    vote = translate_repaired(translator, nl, aps)
+    assert vote.answers == (greedy.stl,)
+
+
 def test_constrained_decoding_on_the_server_equals_the_local_backend(server, llama_backend,
                                                                       paper_split):
     """Tests F+P+C over HTTP: the request's grammar travels in llama.cpp's field, every

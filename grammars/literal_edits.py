@@ -1,0 +1,118 @@
+"""Formulas one edit away from a translation that write what it left out.
+
+A translation that never uses a listed proposition or a stated bound is nearly always
+wrong, and often only by one slip: a proposition written in the wrong slot
+(``G(empty_bin -> F[0,12](empty_bin))`` for "every time the bin is full, empty it
+within 12 steps"), an interval left off an operator (``F(a & F(b))`` for "a, and
+within 10 steps after that, b"), a conjunct dropped. :func:`literal_edits` lists every
+formula one such edit away that writes a missing literal; a model's score picks among
+them (:func:`ara.eval.consistency.translate_repaired`).
+
+The edits, for a missing proposition ``q``: an atom becomes ``q``, ``(a | q)`` or
+``(a & q)``; a subformula ``s`` becomes ``q -> s``; the whole formula gains a conjunct
+``q``, ``F(q)`` or ``G(!q)``. For a missing bound ``n``: a temporal operator gets the
+interval ``[0,n]`` (or keeps one end of its interval and takes ``n`` as the other); a
+subformula ``s`` becomes ``F[0,n](s)`` or ``G[0,n](s)``; with two missing bounds
+``a < b``, an operator gets ``[a,b]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import replace
+from itertools import combinations
+
+from ara.grammars.ast import (
+    Always,
+    And,
+    Atom,
+    Eventually,
+    Formula,
+    Iff,
+    Implies,
+    Interval,
+    Not,
+    Or,
+    Until,
+    children,
+)
+from ara.grammars.printer import to_text
+
+Rebuild = Callable[[Formula], Formula]
+
+
+def literal_edits(formula: Formula, aps: Sequence[str] = (),
+                  bounds: Sequence[int] = ()) -> list[Formula]:
+    """Every formula one edit from ``formula`` that writes one of ``aps`` or ``bounds``.
+
+    Args:
+        formula: The translation to mend.
+        aps: Propositions it should use and does not.
+        bounds: Numbers it should write in an interval and does not.
+
+    Returns:
+        Distinct formulas (by canonical text), in a fixed order, ``formula`` excluded.
+        They may break a request's depth or width limit; check them against its syntax.
+    """
+    out: dict[str, Formula] = {}
+    spots = list(_spots(formula))
+    for q in aps:
+        new = Atom(q)
+        for sub, rebuild in spots:
+            if isinstance(sub, Atom):
+                _add(out, rebuild(new), rebuild(Or((sub, new))), rebuild(And((sub, new))))
+            _add(out, rebuild(Implies(new, sub)))
+        _add(out, And((formula, new)), And((formula, Eventually(new))),
+             And((formula, Always(Not(new)))))
+    for n in bounds:
+        for sub, rebuild in spots:
+            _add(out, *(rebuild(_timed(sub, iv)) for iv in _intervals_with(sub, n)),
+                 rebuild(Eventually(sub, Interval(0, n))), rebuild(Always(sub, Interval(0, n))))
+    for lo, hi in combinations(sorted(set(bounds)), 2):
+        for sub, rebuild in spots:
+            if isinstance(sub, (Eventually, Always, Until)):
+                _add(out, rebuild(_timed(sub, Interval(lo, hi))))
+    out.pop(to_text(formula), None)
+    return list(out.values())
+
+
+def _add(out: dict[str, Formula], *formulas: Formula) -> None:
+    for f in formulas:
+        out.setdefault(to_text(f), f)
+
+
+def _spots(node: Formula) -> Iterator[tuple[Formula, Rebuild]]:
+    """Every subformula of ``node`` (``node`` first, then depth first, left to right),
+    with the function that rebuilds ``node`` around a replacement for it."""
+    yield node, lambda new: new
+    for i, kid in enumerate(children(node)):
+        for sub, rebuild in _spots(kid):
+            yield sub, (lambda new, i=i, rebuild=rebuild: _with_child(node, i, rebuild(new)))
+
+
+def _with_child(node: Formula, i: int, new: Formula) -> Formula:
+    kids = list(children(node))
+    kids[i] = new
+    if isinstance(node, (And, Or)):
+        return type(node)(tuple(kids))
+    if isinstance(node, (Implies, Iff, Until)):
+        return replace(node, lhs=kids[0], rhs=kids[1])
+    return replace(node, arg=kids[0])
+
+
+def _intervals_with(node: Formula, n: int) -> list[Interval]:
+    """Intervals for a temporal operator that write ``n``: ``[0,n]``, and its own
+    interval with ``n`` as the new upper or lower end where that stays an interval."""
+    if not isinstance(node, (Eventually, Always, Until)):
+        return []
+    ivs = [Interval(0, n)]
+    if (iv := node.interval) is not None:
+        if n >= iv.lo:
+            ivs.append(Interval(iv.lo, n))
+        if iv.hi is not None and n <= iv.hi:
+            ivs.append(Interval(n, iv.hi))
+    return ivs
+
+
+def _timed(node: Eventually | Always | Until, interval: Interval) -> Formula:
+    return replace(node, interval=interval)
