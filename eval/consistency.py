@@ -9,10 +9,10 @@ greedy answer, so with one sample this is plain greedy decoding. The cost is
 Repair (:func:`translate_repaired`) looks for another answer only when the greedy one
 leaves out a listed proposition or a stated bound (:mod:`ara.eval.coverage`), and then
 prefers the answers that leave out least; the greedy answer stays unless another says
-more of the request. By default the other answers are the formulas one edit from the
-greedy one that write what it left out, and the model's score of each whole answer
-picks among them; sampled answers are the fallback. On a complete greedy answer
-repair costs nothing.
+more of the request. By default the other answers are samples drawn under the grammar
+and the formulas one edit from the greedy one that write what it left out, and the
+model's score of each whole answer picks among them; where the backend cannot score,
+the samples' majority does. On a complete greedy answer repair costs nothing.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ class Vote:
         groups: Indices into ``results``, one tuple per meaning, largest first.
         ms: Wall time of all generations and checks.
         scores: The model's log-probability of each answer, where answers were scored
-            (repair by edits: those that leave out least); ``None`` for the others.
+            (repair by score: those that leave out least); ``None`` for the others.
     """
 
     results: tuple[TranslationResult, ...]

@@ -93,7 +93,7 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
     with pytest.raises(ConfigError, match="samples must be >= 0"):
         translate_repaired(t, nl, aps, samples=-1)
-    with pytest.raises(ConfigError, match="choose one of samples\+edits, edits, samples"):
+    with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
         translate_repaired(t, nl, aps, by="votes")
 
 

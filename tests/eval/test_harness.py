@@ -49,7 +49,7 @@ def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
     assert repaired.repair_by == "samples+edits"
     with pytest.raises(ConfigError, match="repair from 0 to 32"):
         AblationConfig(repair=33)
-    with pytest.raises(ConfigError, match="choose one of samples\+edits, edits, samples"):
+    with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
         AblationConfig(repair=8, repair_by="votes")
 
 

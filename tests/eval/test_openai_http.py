@@ -70,7 +70,7 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
     from ara.eval.coverage import gaps
     from ara.grammars import parse
 
-    translator = Translator(OpenAIBackend(server))
+    translator = Translator(OpenAIBackend(server, server="llama"))
     assert not can_score(translator)
     with pytest.raises(BackendError, match="cannot score answers; use a local model"):
         translator.score("eventually (prop_1)", ["prop_1"], [parse("F(prop_1)")])
