@@ -122,9 +122,10 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
         A :class:`Vote` of one answer when the greedy one leaves nothing out,
         ``samples`` is 0, or the backend can neither score nor sample (an HTTP
         server); otherwise of all answers considered, greedy first. The
-        greedy answer wins unless another leaves out less. Scored answers form one
-        group each, best score first; a mended answer's result is the greedy one's
-        with the formula replaced (timings and token counts are the greedy call's).
+        greedy answer wins unless another leaves out less. Ranked by score, answers
+        of the same text share a group, best score first; a mended answer's result is
+        the greedy one's with the formula replaced (timings and token counts are the
+        greedy call's).
     """
     if samples < 0:
         raise ConfigError(f"samples must be >= 0, got {samples}")
@@ -151,7 +152,7 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
             stays = missing[0] == min(missing)
             order = sorted(range(len(results)), key=lambda i: (
                 scores[i] is None, not (stays and i == 0), -(scores[i] or 0)))
-            return Vote(tuple(results), tuple((i,) for i in order),
+            return Vote(tuple(results), _same_text(results, order),
                         (time.perf_counter() - start) * 1e3, tuple(scores))
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
                               grammar_in_prompt)]
@@ -170,6 +171,16 @@ def _scores(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence
                                              grammar_in_prompt), strict=True))
     return [scored[r.stl] if m == min(missing) else None
             for r, m in zip(results, missing, strict=True)]
+
+
+def _same_text(results: Sequence[TranslationResult],
+               order: Sequence[int]) -> tuple[tuple[int, ...], ...]:
+    """``order`` grouped by formula text, each group where its first member stands: a
+    sample that repeats another answer votes with it, as in :attr:`Vote.agreement`."""
+    groups: dict[str | None, list[int]] = {}
+    for i in order:
+        groups.setdefault(results[i].stl, []).append(i)
+    return tuple(tuple(g) for g in groups.values())
 
 
 def can_score(translator: Translator) -> bool:

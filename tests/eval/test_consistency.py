@@ -120,6 +120,8 @@ def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by
     assert scored == [i for i, m in enumerate(missing) if m == min(missing)]
     winner = vote.groups[0][0]
     assert winner in scored and vote.scores[winner] == max(vote.scores[i] for i in scored)
+    assert sorted(i for g in vote.groups for i in g) == list(range(len(vote.answers)))
+    assert all(len({vote.answers[i] for i in g}) == 1 for g in vote.groups)  # by text
     assert missing[winner] < len(left_out)
     assert t.score(nl, aps, [parse(vote.result.stl)])[0] == pytest.approx(vote.scores[winner],
                                                                          abs=0.2)
