@@ -42,7 +42,13 @@ from tqdm import tqdm
 
 from ara.data import load_or_prepare
 from ara.eval.backends.base import Sampling
-from ara.eval.consistency import _missing, literal_mends, rank_repairs
+from ara.eval.consistency import (
+    _missing,
+    literal_mends,
+    rank_repairs,
+    rank_scored,
+    score_complete,
+)
 from ara.eval.coverage import gaps
 from ara.eval.harness import judge
 from ara.eval.models import make_backend
@@ -102,11 +108,8 @@ def winner(translator: Translator, nl: str, aps: list[str], answers: list, score
     missing = [_missing(nl, aps, a) for a in answers]
     if not scored:
         return answers[rank_repairs(answers, missing, timeout_s)[0][0]]
-    if missing[0] == min(missing):  # as repair does: greedy stays unless beaten
-        return answers[0]
-    least = [a for a, m in zip(answers, missing, strict=True) if m == min(missing)]
-    scores = translator.score(nl, aps, [parse(a) for a in least])
-    return least[max(range(len(least)), key=scores.__getitem__)]
+    scores = score_complete(translator, nl, aps, answers, missing)
+    return answers[rank_scored(missing, scores)[0]]
 
 
 def main() -> None:

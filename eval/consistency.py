@@ -146,13 +146,11 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
         if drawn or mends:
             results = [greedy, *drawn, *(replace(greedy, raw=ANSWER_PREFIX + text, stl=text)
                                          for text in mends)]
-            missing = [_missing(nl, aps, r.stl, bounds) for r in results]
-            scores = _scores(translator, nl, aps, shots, grammar_in_prompt, results, missing)
-            # As with samples, the greedy answer stays unless another leaves out less.
-            stays = missing[0] == min(missing)
-            order = sorted(range(len(results)), key=lambda i: (
-                scores[i] is None, not (stays and i == 0), -(scores[i] or 0)))
-            return Vote(tuple(results), _same_text(results, order),
+            answers = [r.stl for r in results]
+            missing = [_missing(nl, aps, a, bounds) for a in answers]
+            scores = score_complete(translator, nl, aps, answers, missing, shots,
+                                    grammar_in_prompt)
+            return Vote(tuple(results), _same_text(results, rank_scored(missing, scores)),
                         (time.perf_counter() - start) * 1e3, tuple(scores))
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
                               grammar_in_prompt)]
@@ -161,16 +159,26 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
-def _scores(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],
-            grammar_in_prompt: bool, results: Sequence[TranslationResult],
-            missing: Sequence[float]) -> list[float | None]:
-    """The model's score of each answer that leaves out least (``None`` for the rest);
-    an answer given twice is scored once."""
-    pool = sorted({r.stl for r, m in zip(results, missing, strict=True) if m == min(missing)})
-    scored = dict(zip(pool, translator.score(nl, aps, [parse(t) for t in pool], shots,
+def score_complete(translator: Translator, nl: str, aps: Sequence[str],
+                   answers: Sequence[str | None], missing: Sequence[float],
+                   shots: Sequence[Shot] = (),
+                   grammar_in_prompt: bool = False) -> list[float | None]:
+    """The model's score of each answer that leaves out least (``missing[i]``: how much
+    answer ``i`` leaves out), ``None`` for the rest; an answer given twice is scored
+    once."""
+    least = min(missing)
+    pool = sorted({a for a, m in zip(answers, missing, strict=True) if m == least})
+    scored = dict(zip(pool, translator.score(nl, aps, [parse(a) for a in pool], shots,
                                              grammar_in_prompt), strict=True))
-    return [scored[r.stl] if m == min(missing) else None
-            for r, m in zip(results, missing, strict=True)]
+    return [scored[a] if m == least else None for a, m in zip(answers, missing, strict=True)]
+
+
+def rank_scored(missing: Sequence[float], scores: Sequence[float | None]) -> list[int]:
+    """Indices of answers (greedy first) ranked by score, the scored ones first; as with
+    samples, the greedy answer stays first unless another leaves out less."""
+    stays = missing[0] == min(missing)
+    return sorted(range(len(missing)), key=lambda i: (
+        scores[i] is None, not (stays and i == 0), -(scores[i] or 0)))
 
 
 def _same_text(results: Sequence[TranslationResult],

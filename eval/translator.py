@@ -245,8 +245,7 @@ class Translator:
         built = self.grammar(aps, nl)
         if require and constrained:
             built = _requiring(built, tuple(require))
-        shown = grammar_for_prompt(built.syntax) if grammar_in_prompt else None
-        prompt = build_prompt(nl, aps, shots, shown)
+        prompt = self._prompt(nl, aps, shots, grammar_in_prompt, built.syntax)
         if constrained:
             decoding = decoding_grammar(built)
             budget = int(decoding.grammar.max_length()) + 1
@@ -286,9 +285,17 @@ class Translator:
         if score is None:
             raise BackendError(f"{type(self.backend).__name__} cannot score answers; "
                                "use a local model (llama.cpp or transformers)")
-        shown = grammar_for_prompt(self.grammar(aps, nl).syntax) if grammar_in_prompt else None
-        prompt = build_prompt(nl, tuple(aps), shots, shown)
+        prompt = self._prompt(nl, tuple(aps), shots, grammar_in_prompt,
+                              self.grammar(aps, nl).syntax)
         return score(prompt, [ANSWER_PREFIX + to_text(f) + STOP for f in formulas])
+
+    @staticmethod
+    def _prompt(nl: str, aps: tuple[str, ...], shots: Sequence[Shot], grammar_in_prompt: bool,
+                syntax: Syntax) -> str:
+        """The prompt both translating and scoring see, so that a score is of the answer
+        to the very prompt a translation answered."""
+        return build_prompt(nl, aps, shots, grammar_for_prompt(syntax) if grammar_in_prompt
+                            else None)
 
     @staticmethod
     def _check_guarantee(built: BuiltGrammar, raw: str, stop: str) -> None:

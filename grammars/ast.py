@@ -219,15 +219,21 @@ def depth(node: Formula) -> int:
     return 0 if not kids else 1 + max(depth(k) for k in kids)
 
 
-def map_children(node: Formula, fn: Callable[[Formula], Formula]) -> Formula:
-    """A copy of ``node`` with ``fn`` applied to each direct subformula."""
+def with_children(node: Formula, kids: tuple[Formula, ...]) -> Formula:
+    """A copy of ``node`` whose direct subformulas are ``kids`` (as :func:`children`
+    lists them), its operator and interval kept."""
     if isinstance(node, (Atom, Const)):
         return node
     if isinstance(node, (And, Or)):
-        return type(node)(tuple(fn(a) for a in node.args))
+        return type(node)(kids)
     if isinstance(node, (Implies, Iff, Until)):
-        return replace(node, lhs=fn(node.lhs), rhs=fn(node.rhs))
-    return replace(node, arg=fn(node.arg))
+        return replace(node, lhs=kids[0], rhs=kids[1])
+    return replace(node, arg=kids[0])
+
+
+def map_children(node: Formula, fn: Callable[[Formula], Formula]) -> Formula:
+    """A copy of ``node`` with ``fn`` applied to each direct subformula."""
+    return with_children(node, tuple(fn(child) for child in children(node)))
 
 
 def rename_atoms(node: Formula, names: dict[str, str]) -> Formula:

@@ -28,13 +28,13 @@ from ara.grammars.ast import (
     Atom,
     Eventually,
     Formula,
-    Iff,
     Implies,
     Interval,
     Not,
     Or,
     Until,
     children,
+    with_children,
 )
 from ara.grammars.printer import to_text
 
@@ -66,12 +66,12 @@ def literal_edits(formula: Formula, aps: Sequence[str] = (),
              And((formula, Always(Not(new)))))
     for n in bounds:
         for sub, rebuild in spots:
-            _add(out, *(rebuild(_timed(sub, iv)) for iv in _intervals_with(sub, n)),
+            _add(out, *(rebuild(replace(sub, interval=iv)) for iv in _intervals_with(sub, n)),
                  rebuild(Eventually(sub, Interval(0, n))), rebuild(Always(sub, Interval(0, n))))
     for lo, hi in combinations(sorted(set(bounds)), 2):
         for sub, rebuild in spots:
             if isinstance(sub, (Eventually, Always, Until)):
-                _add(out, rebuild(_timed(sub, Interval(lo, hi))))
+                _add(out, rebuild(replace(sub, interval=Interval(lo, hi))))
     out.pop(to_text(formula), None)
     return list(out.values())
 
@@ -85,19 +85,11 @@ def _spots(node: Formula) -> Iterator[tuple[Formula, Rebuild]]:
     """Every subformula of ``node`` (``node`` first, then depth first, left to right),
     with the function that rebuilds ``node`` around a replacement for it."""
     yield node, lambda new: new
-    for i, kid in enumerate(children(node)):
+    kids = children(node)
+    for i, kid in enumerate(kids):
         for sub, rebuild in _spots(kid):
-            yield sub, (lambda new, i=i, rebuild=rebuild: _with_child(node, i, rebuild(new)))
-
-
-def _with_child(node: Formula, i: int, new: Formula) -> Formula:
-    kids = list(children(node))
-    kids[i] = new
-    if isinstance(node, (And, Or)):
-        return type(node)(tuple(kids))
-    if isinstance(node, (Implies, Iff, Until)):
-        return replace(node, lhs=kids[0], rhs=kids[1])
-    return replace(node, arg=kids[0])
+            yield sub, (lambda new, i=i, rebuild=rebuild: with_children(
+                node, kids[:i] + (rebuild(new),) + kids[i + 1:]))
 
 
 def _intervals_with(node: Formula, n: int) -> list[Interval]:
@@ -113,6 +105,3 @@ def _intervals_with(node: Formula, n: int) -> list[Interval]:
             ivs.append(Interval(n, iv.hi))
     return ivs
 
-
-def _timed(node: Eventually | Always | Until, interval: Interval) -> Formula:
-    return replace(node, interval=interval)
