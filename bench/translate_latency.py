@@ -11,9 +11,12 @@ under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one w
 call first. A formula's time depends on its length, so tokens per answer are shown too.
 Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
 with the default grammar, so a candidate is timed beside what ships, in the same run.
-``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`), by
-edits (the default) and by samples: its median is the greedy answer's, its mean carries
-the extra work for the few whose greedy answer leaves part of the request out.
+``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`),
+by samples+edits (the default; it also draws for a complete answer the model doubts),
+by edits and by samples: its median is the greedy answer's, its mean carries the extra
+work for the few it acts on. The row "ara translate" is what the command does by
+default: repair, then the model's probability of the answer it gives (the confidence
+note; free where repair scored the answer already).
 """
 
 from __future__ import annotations
@@ -23,19 +26,27 @@ import os
 import platform
 import random
 import statistics
+import time
 
 from ara.data import load_or_prepare
+from ara.eval.confidence import winner_probability
 from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator, TranslatorConfig
 
 
-def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0]) -> dict:
+def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0],
+            confidence: bool = False) -> dict:
     translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
     if repair:
-        votes = [translate_repaired(translator, r.nl, r.aps, samples=repair, by=by)
-                 for r in records]
-        runs, ms = [v.result for v in votes], [v.ms for v in votes]
+        runs, ms = [], []
+        for r in records:
+            start = time.perf_counter()
+            vote = translate_repaired(translator, r.nl, r.aps, samples=repair, by=by)
+            if confidence:  # what `ara translate` adds for its note
+                winner_probability(translator, vote)
+            runs.append(vote.result)
+            ms.append((time.perf_counter() - start) * 1e3)
     else:
         runs = [translator.translate(r.nl, r.aps) for r in records]
         ms = [r.ms for r in runs]
@@ -65,6 +76,9 @@ def main() -> None:
             *[("finetuned", TranslatorConfig(), f"--repair {args.repair} --repair-by {by}",
                "bounds the sentence writes", (args.repair, by))
               for by in REPAIR_BY if args.repair],
+            *[("finetuned", TranslatorConfig(), "ara translate: repair and confidence",
+               "bounds the sentence writes", (args.repair, REPAIR_BY[0], True))
+              for _ in range(bool(args.repair))],
             ("finetuned", TranslatorConfig(bounds_from_request=False), "--any-bound",
              "any bound up to 1000", 0),
             ("finetuned", TranslatorConfig(intervals=False), "--no-intervals", "no time bounds",

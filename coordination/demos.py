@@ -118,36 +118,39 @@ def _own_order(world: GridWorld, h: Helper) -> list[str]:
 def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
     aps = tuple(errand.places)
     echo(f"[instruction] {errand.nl}")
-    warning = None
+    warnings, probability = [], None
     if translator is None:
         stl, source = errand.reference, "reference"
     else:
+        from ara.eval.confidence import DOUBT, doubt_warning, winner_probability
         from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
         from ara.eval.coverage import gaps
 
-        # Repaired as `ara translate` repairs, so the demo shows what a user would get
-        result = translate_repaired(translator, errand.nl, aps, samples=DEFAULT_REPAIR).result
-        stl, source = result.stl, f"translated by {translator.backend.model_id}"
-        if gap := gaps(errand.nl, aps, parse(stl)):
-            warning = gap.warning()
+        # Repaired and checked as `ara translate` does, so the demo shows what a user gets
+        vote = translate_repaired(translator, errand.nl, aps, samples=DEFAULT_REPAIR)
+        stl, source = vote.result.stl, f"translated by {translator.backend.model_id}"
+        warnings = [gap.warning()] if (gap := gaps(errand.nl, aps, parse(stl))) else []
+        probability = winner_probability(translator, vote)
+        if probability is not None and probability < DOUBT:
+            warnings.append(doubt_warning(stl, probability))
     echo(f"[STL, {source}] {stl}")
-    if warning:
+    for warning in warnings:
         echo(warning)
+    said = {"stl": stl, "source": source, "confidence": probability}
     vocab = Vocabulary(errand.places)
     try:
         plan = plan_spec(world, errand.start, {"task": parse(stl)}, vocab, "makespan")
     except UnsupportedSpec as err:
         echo(f"[planner] cannot plan: {err}")
-        return {"title": "no plan", "stl": stl, "source": source, "status": "unsupported",
-                "reason": str(err), "paths": {}}
+        return {"title": "no plan", **said, "status": "unsupported", "reason": str(err),
+                "paths": {}}
     if not plan.feasible:
         echo(f"[planner] no plan: {plan.status}")
-        return {"title": "no plan", "stl": stl, "source": source, "status": plan.status,
-                "paths": {}}
+        return {"title": "no plan", **said, "status": plan.status, "paths": {}}
     echo("[plan] " + " -> ".join(f"{e}@t={plan.times[e]}" for e in plan.order)
          + f"  (makespan {plan.makespan}, solved in {plan.solve_s * 1000:.1f} ms)")
-    return {"title": f"{' -> '.join(plan.order)} (makespan {plan.makespan})", "stl": stl,
-            "source": source, "status": plan.status, "order": plan.order, "times": plan.times,
+    return {"title": f"{' -> '.join(plan.order)} (makespan {plan.makespan})", **said,
+            "status": plan.status, "order": plan.order, "times": plan.times,
             "makespan": plan.makespan,
             "paths": {"robot": _trace(world, errand.start,
                                       [errand.places[e] for e in plan.order])},

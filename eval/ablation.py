@@ -45,11 +45,9 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
         pool = ThreadPoolExecutor(concurrency) if concurrency > 1 else None
         try:
             if pool is None:
-                answers = (translate_job(translator, job, config.repair, config.repair_by)
-                           for job in todo)
+                answers = (translate_job(translator, job, config) for job in todo)
             else:  # in the planned order, whatever order they finish in
-                answers = pool.map(lambda job: translate_job(translator, job, config.repair,
-                                                             config.repair_by), todo)
+                answers = pool.map(lambda job: translate_job(translator, job, config), todo)
             for i, (job, answer) in enumerate(zip(todo, answers, strict=True), 1):
                 sample = sample_of(job, answer, config.spot_timeout_s)
                 store.append(sample)

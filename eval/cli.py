@@ -10,6 +10,7 @@ import typer
 
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
+from ara.eval.confidence import DOUBT
 from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
 from ara.eval.consistency import REPAIR_BY, translate_consistent, translate_repaired
 
@@ -67,12 +68,24 @@ def translate_cmd(
              "highest of those that leave out least wins. edits: the edits alone. "
              "samples: the majority of the K drawn that leave out least (also what the "
              "others do with an HTTP --model, which cannot score)."),
+    doubt: float = typer.Option(
+        DOUBT, "--doubt", min=0.0, max=1.0,
+        help="With repair by samples+edits: also draw the K answers when the greedy "
+             "answer leaves nothing out but the model gives it a probability below this, "
+             "and keep the best-scored complete one. 0: repair answers with a gap only."),
     server: str = typer.Option("openai", "--server", help=SERVER_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
-    """Translate one instruction into STL over the given propositions."""
+    """Translate one instruction into STL over the given propositions.
+
+    Prints the formula. On stderr: a warning when it leaves out a listed
+    proposition or a stated bound, and a note with the formula read back in
+    English when the model gives its answer a probability below 0.5 (about
+    half of such held-out answers were wrong). --json has it as "confidence".
+    """
     from ara.data import load_or_prepare
     from ara.data.normalize import form_of
+    from ara.eval.confidence import answer_probability, doubt_warning, winner_probability
     from ara.eval.coverage import gaps
     from ara.eval.models import default_shots, make_backend
     from ara.eval.prompt import sample_shots
@@ -107,7 +120,8 @@ def translate_cmd(
             result = vote.result
         elif repair:
             vote = translate_repaired(translator, nl, names, examples, repair, temperature,
-                                      seed, grammar_in_prompt=grammar_in_prompt, by=repair_by)
+                                      seed, grammar_in_prompt=grammar_in_prompt, by=repair_by,
+                                      doubt=doubt)
             result = vote.result
         else:
             result = translator.translate(nl, names, examples, grammar_in_prompt,
@@ -122,11 +136,18 @@ def translate_cmd(
         if vote.scores:
             data["samples"]["scores"] = [None if x is None else round(x, 3)
                                          for x in vote.scores]
+    with user_errors():
+        probability = (winner_probability(translator, vote, examples, grammar_in_prompt)
+                       if vote else answer_probability(translator, nl, names, result.stl,
+                                                       examples, grammar_in_prompt))
+    data["confidence"] = None if probability is None else round(probability, 3)
     if result.stl is not None:
         gap = gaps(nl, names, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
         if gap and not as_json:
             typer.echo(gap.warning(), err=True)
+        if probability is not None and probability < DOUBT and not as_json:
+            typer.echo(doubt_warning(result.stl, probability), err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
 
 
@@ -167,6 +188,10 @@ def ablation_cmd(
         help="samples+edits (the model's best-scored of the K drawn and the greedy "
              "answer's one-edit mends), edits (the mends alone) or samples (the majority "
              "of the K drawn)."),
+    doubt: float = typer.Option(
+        DOUBT, "--doubt", min=0.0, max=1.0,
+        help="With --repair by samples+edits: also draw for a complete greedy answer the "
+             "model gives a probability below this (0: answers with a gap only)."),
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import run_ablation
@@ -181,7 +206,7 @@ def ablation_cmd(
             split=split, form=form, variants=split_list(variants),
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
-            repair_by=repair_by,
+            repair_by=repair_by, repair_doubt=doubt,
         )
         backend = make_backend(model, mask=mask, server=server)
         try:

@@ -12,17 +12,22 @@ prefers the answers that leave out least; the greedy answer stays unless another
 more of the request. By default the other answers are samples drawn under the grammar
 and the formulas one edit from the greedy one that write what it left out, and the
 model's score of each whole answer picks among them; where the backend cannot score,
-the samples' majority does. On a complete greedy answer repair costs nothing.
+the samples' majority does. A complete greedy answer costs one score: if the model
+gives it a probability below :data:`~ara.eval.confidence.DOUBT`, samples are drawn
+and the best-scored complete answer wins (a search for the likelier answer that greedy
+decoding missed); otherwise it stands.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
+from ara.eval.confidence import DOUBT
 from ara.eval.coverage import gaps
 from ara.eval.prompt import Shot
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
@@ -31,8 +36,9 @@ from ara.grammars.literal_edits import literal_edits
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
-#: samples+edits it fixed 8 of 473 held-out greedy answers and lost none, acting on 18
-#: (by samples alone 4; docs/generalization.md, "Repair by the model's score").
+#: samples+edits on gaps it fixed 8 of 473 held-out greedy answers and lost none, acting
+#: on 18 (by samples alone 4); on doubted answers too, 16 fixed and 2 lost, acting on
+#: 118 (docs/generalization.md, "Repair by the model's score", "How sure the model is").
 DEFAULT_REPAIR = 8
 
 #: How repair looks for a better answer (see :func:`translate_repaired`).
@@ -101,9 +107,10 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
 def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
                        shots: Sequence[Shot] = (), samples: int = 8,
                        temperature: float = 0.7, seed: int = 0, timeout_s: float = 10.0,
-                       grammar_in_prompt: bool = False, by: str = "samples+edits") -> Vote:
+                       grammar_in_prompt: bool = False, by: str = "samples+edits",
+                       doubt: float = DOUBT) -> Vote:
     """Translate ``nl`` greedily; if the answer leaves out part of the request, look for
-    one that leaves out less.
+    one that leaves out less, and if the model doubts it, for one it scores higher.
 
     Args:
         translator, nl, aps, shots, temperature, timeout_s, grammar_in_prompt: As
@@ -117,12 +124,18 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
             (drawn only if no edit fits the request's grammar). ``samples``: keep the
             majority meaning among the samples that leave out least, which is also
             what the other two do where the backend cannot score.
+        doubt: By ``samples+edits`` on a backend that scores: when the greedy answer
+            leaves nothing out but the model gives it a probability below ``doubt``
+            (:mod:`ara.eval.confidence`), draw ``samples`` answers and keep the
+            best-scored of those and the greedy one that leave nothing out (an answer
+            above 0.5 is the likeliest there is, so nothing is drawn for it); 0: act
+            on gaps only.
 
     Returns:
-        A :class:`Vote` of one answer when the greedy one leaves nothing out,
-        ``samples`` is 0, or the backend can neither score nor sample (an HTTP
-        server); otherwise of all answers considered, greedy first. The
-        greedy answer wins unless another leaves out less. Ranked by score, answers
+        A :class:`Vote` of one answer when the greedy one leaves nothing out (and is
+        not doubted), ``samples`` is 0, or the backend can neither score nor sample (an
+        HTTP server); otherwise of all answers considered, greedy first. With a gap,
+        the greedy answer wins unless another leaves out less. Ranked by score, answers
         of the same text share a group, best score first; a mended answer's result is
         the greedy one's with the formula replaced (timings and token counts are the
         greedy call's).
@@ -131,15 +144,21 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
         raise ConfigError(f"samples must be >= 0, got {samples}")
     if by not in REPAIR_BY:
         raise ConfigError(f"repair by {by!r}? choose one of {', '.join(REPAIR_BY)}")
+    if not 0 <= doubt <= 1:
+        raise ConfigError(f"doubt is a probability, 0 to 1 (0: gaps only); got {doubt}")
     start = time.perf_counter()
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
     # Without intervals no answer can write a bound: only propositions can be mended.
     bounds = translator.config.intervals
     gap = _missing(nl, aps, greedy.stl, bounds)
-    helpless = not can_score(translator) and not getattr(translator.backend, "can_sample", True)
-    if not samples or not 0 < gap < float("inf") or helpless:
+    helpless = not translator.can_score and not getattr(translator.backend, "can_sample", True)
+    if not samples or gap == float("inf") or helpless:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
-    if by != "samples" and can_score(translator):
+    if not gap:
+        return _unless_doubted(translator, greedy, shots, samples, temperature, seed,
+                               grammar_in_prompt, doubt if by == "samples+edits" else 0.0,
+                               start)
+    if by != "samples" and translator.can_score:
         drawn = (_draw(translator, nl, aps, shots, samples, temperature, seed,
                        grammar_in_prompt) if by == "samples+edits" else [])
         mends = literal_mends(translator, nl, aps, greedy.stl, bounds)
@@ -159,6 +178,29 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
+def _unless_doubted(translator: Translator, greedy: TranslationResult, shots: Sequence[Shot],
+                    samples: int, temperature: float, seed: int, grammar_in_prompt: bool,
+                    doubt: float, start: float) -> Vote:
+    """The complete greedy answer, with its score where the backend scores; if the model
+    gives it a probability below ``doubt``, the best-scored of it and ``samples`` drawn
+    answers that leave nothing out."""
+    nl, aps = greedy.nl, greedy.aps
+    if not doubt or not translator.can_score:
+        return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
+    (score,) = translator.score(nl, aps, [parse(greedy.stl)], shots, grammar_in_prompt)
+    if math.exp(score) >= doubt:
+        return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
+    results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
+                              grammar_in_prompt)]
+    answers = [r.stl for r in results]
+    bounds = translator.config.intervals
+    missing = [_missing(nl, aps, a, bounds) for a in answers]
+    scores = score_complete(translator, nl, aps, answers, missing, shots, grammar_in_prompt)
+    order = rank_scored(missing, scores, greedy_stays=False)
+    return Vote(tuple(results), _same_text(results, order),
+                (time.perf_counter() - start) * 1e3, tuple(scores))
+
+
 def score_complete(translator: Translator, nl: str, aps: Sequence[str],
                    answers: Sequence[str | None], missing: Sequence[float],
                    shots: Sequence[Shot] = (),
@@ -173,10 +215,12 @@ def score_complete(translator: Translator, nl: str, aps: Sequence[str],
     return [scored[a] if m == least else None for a, m in zip(answers, missing, strict=True)]
 
 
-def rank_scored(missing: Sequence[float], scores: Sequence[float | None]) -> list[int]:
+def rank_scored(missing: Sequence[float], scores: Sequence[float | None],
+                greedy_stays: bool = True) -> list[int]:
     """Indices of answers (greedy first) ranked by score, the scored ones first; as with
-    samples, the greedy answer stays first unless another leaves out less."""
-    stays = missing[0] == min(missing)
+    samples, the greedy answer stays first unless another leaves out less (unless not
+    ``greedy_stays``: then it competes by score like the rest)."""
+    stays = greedy_stays and missing[0] == min(missing)
     return sorted(range(len(missing)), key=lambda i: (
         scores[i] is None, not (stays and i == 0), -(scores[i] or 0)))
 
@@ -189,11 +233,6 @@ def _same_text(results: Sequence[TranslationResult],
     for i in order:
         groups.setdefault(results[i].stl, []).append(i)
     return tuple(tuple(g) for g in groups.values())
-
-
-def can_score(translator: Translator) -> bool:
-    """Whether the translator's backend can score answers (the local ones can)."""
-    return callable(getattr(translator.backend, "score", None))
 
 
 def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],

@@ -20,6 +20,7 @@ from ara import __version__
 from ara.data import PreparedSplit, Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
+from ara.eval.confidence import DOUBT
 from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
@@ -85,6 +86,9 @@ class AblationConfig:
             the greedy answer's one-edit mends), ``edits`` (the mends alone) or
             ``samples`` (the majority of those drawn; also the others' way where the
             backend cannot score).
+        repair_doubt: By ``samples+edits``: also draw for a complete greedy answer the
+            model gives a probability below this, 0 to 1 (0: gaps only; runs repaired
+            before it existed read as 0).
     """
 
     split: str = "paper"
@@ -100,6 +104,7 @@ class AblationConfig:
     translator: TranslatorConfig = field(default_factory=TranslatorConfig)
     repair: int = 0
     repair_by: str = REPAIR_BY[0]
+    repair_doubt: float = DOUBT
 
     def __post_init__(self) -> None:
         if self.split not in SPLITS:
@@ -119,6 +124,8 @@ class AblationConfig:
                 f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
                 f"limit={self.limit}, repair={self.repair}"
             )
+        if not 0 <= self.repair_doubt <= 1:
+            raise ConfigError(f"repair_doubt is a probability, 0 to 1; got {self.repair_doubt}")
         if self.repair_by not in REPAIR_BY:
             raise ConfigError(f"repair by {self.repair_by!r}? choose one of "
                               f"{', '.join(REPAIR_BY)}")
@@ -127,7 +134,7 @@ class AblationConfig:
         data = asdict(self)
         data["variants"], data["shots"] = list(self.variants), list(self.shots)
         if not self.repair:  # as runs from before repair existed wrote it: they resume
-            del data["repair"], data["repair_by"]
+            del data["repair"], data["repair_by"], data["repair_doubt"]
         return data
 
     @classmethod
@@ -139,6 +146,8 @@ class AblationConfig:
         data = dict(data)
         if data.get("repair") and "repair_by" not in data:
             data["repair_by"] = "samples"  # repaired before repair by edits existed
+        if data.get("repair") and "repair_doubt" not in data:
+            data["repair_doubt"] = 0.0  # repaired before doubted answers were
         data["variants"], data["shots"] = tuple(data["variants"]), tuple(data["shots"])
         data["translator"] = TranslatorConfig(**data.get("translator", {}))
         return cls(**data)
@@ -229,14 +238,14 @@ class Answer:
         return self.result.ms if self.ms is None else self.ms
 
 
-def translate_job(translator: Translator, job: Job, repair: int = 0,
-                  repair_by: str = REPAIR_BY[0]) -> Answer:
-    """The generation of one job (what may run concurrently against a server)."""
+def translate_job(translator: Translator, job: Job, config: AblationConfig) -> Answer:
+    """The generation of one job (what may run concurrently against a server), repaired
+    as ``config`` says."""
     r = job.record
-    if repair and job.variant.constrained:
-        vote = translate_repaired(translator, r.nl, r.aps, job.examples, samples=repair,
+    if config.repair and job.variant.constrained:
+        vote = translate_repaired(translator, r.nl, r.aps, job.examples, samples=config.repair,
                                   grammar_in_prompt=job.variant.grammar_in_prompt,
-                                  by=repair_by)
+                                  by=config.repair_by, doubt=config.repair_doubt)
         return Answer(vote.result, len(vote.results), vote.ms)
     return Answer(translator.translate(r.nl, r.aps, job.examples,
                                        job.variant.grammar_in_prompt, job.variant.constrained))

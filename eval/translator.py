@@ -273,6 +273,12 @@ class Translator:
             grammar=built.provenance() if constrained else {},
         )
 
+    @property
+    def can_score(self) -> bool:
+        """Whether the backend can score answers (the local ones can; an HTTP server
+        cannot)."""
+        return callable(getattr(self.backend, "score", None))
+
     def score(self, nl: str, aps: Sequence[str], formulas: Sequence[Formula],
               shots: Sequence[Shot] = (), grammar_in_prompt: bool = False) -> list[float]:
         """The model's log-probability of each formula as the answer to ``nl``, written

@@ -21,6 +21,8 @@ with :class:`~ara.errors.BoundTooLargeError` rather than left to run for minutes
 from __future__ import annotations
 
 import multiprocessing
+import os
+import sys
 from functools import lru_cache
 
 from ara.errors import AraError, BoundTooLargeError
@@ -199,7 +201,7 @@ class _Worker:
     def __init__(self) -> None:
         ctx = multiprocessing.get_context("spawn")  # no fork: the parent may hold threads
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_serve, args=(child,), daemon=True)
+        self.proc = ctx.Process(target=_serve, args=(child, os.getpid()), daemon=True)
         self.proc.start()
         self.cache: dict[tuple[str, str, str], bool] = {}
 
@@ -225,10 +227,33 @@ class _Worker:
         return self.cache[key]
 
 
-def _serve(conn) -> None:
+def _serve(conn, parent: int) -> None:
+    _die_with(parent)
     while True:
-        op, a, b = conn.recv()
+        try:
+            op, a, b = conn.recv()
+        except EOFError:  # the parent closed its end: nothing more to decide
+            return
         conn.send(_equivalent(a, b) if op == "equivalent" else _implies(a, b))
+
+
+def _die_with(parent: int) -> None:
+    """Have Linux kill this worker when the process that started it dies.
+
+    ``daemon=True`` only covers a parent that exits normally; a run killed by a signal
+    would leave a check running in Spot's C++, which holds the GIL and can take an hour
+    and gigabytes. Linux ties the signal to the thread that started the worker; if
+    that thread ends first, the next check starts a new worker.
+    """
+    if sys.platform != "linux":
+        return
+    import ctypes
+    import signal
+
+    pr_set_pdeathsig = 1
+    ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL)
+    if os.getppid() != parent:  # it died before the line above took effect
+        os._exit(0)
 
 
 @lru_cache(maxsize=65536)

@@ -12,7 +12,9 @@
 # paper and disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
 # Spot's limit 5 s a pair (undecided counts as wrong); $REPAIR (default 0) turns repair on
 # when a constrained answer leaves part of the request out (`ara eval ablation --repair`,
-# $REPAIR answers drawn where sampling is the way), by $REPAIR_BY (default samples+edits).
+# $REPAIR answers drawn where sampling is the way), by $REPAIR_BY (default samples+edits),
+# also acting on a complete answer the model gives a probability below $DOUBT (default
+# 0.5; 0: gaps only).
 # Each run resumes from its samples.
 # `scripts/generalization_table.py` prints the table from what is there.
 set -euo pipefail
@@ -27,7 +29,7 @@ out=docs/results/generalization/$name
 run() {  # SPLIT FORM LIMIT [VARIANTS]
   .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \
     --variants "${4:-$variants}" --shots 5 --reruns 1 --seed 0 --spot-timeout 5 --resume \
-    --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" \
+    --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" --doubt "${DOUBT:-0.5}" \
     --no-progress --out "$out/$1-$2" > /dev/null
   echo "done: $name $1 $2"
 }

@@ -86,6 +86,16 @@ def llama_backend(embedded_model_path):
 
 
 @pytest.fixture(scope="session")
+def finetuned(embedded_model_path):
+    """The shipped fine-tune (``--model finetuned``) through llama.cpp (loaded once)."""
+    from ara.eval.models import FINETUNED_LORA, make_backend
+
+    if not FINETUNED_LORA.is_file():
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (scripts/finetune_270m.sh)")
+    return make_backend("finetuned")
+
+
+@pytest.fixture(scope="session")
 def paper_split():
     """The registered paper split, prepared if this machine has not yet."""
     from ara.data import load_split, prepare

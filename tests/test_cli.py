@@ -197,3 +197,18 @@ def test_translate_warns_when_the_answer_leaves_part_of_the_request_out():
     out = ara("translate", *args, "--json")
     assert json.loads(out.stdout)["left_out"] == {"aps": [], "numbers": [5]}
     assert "warning" not in out.stderr  # JSON users read the field
+
+
+@needs_llama
+def test_translate_notes_an_answer_the_model_doubts():
+    """Tests the note and the JSON field: a sentence of words that say nothing temporal
+    gets an answer the model gives a low probability, read back in English; a plain
+    instruction gets neither note nor doubt."""
+    args = ["( prop_1 ) purple elephant ( prop_2 )", "--aps", "prop_1,prop_2"]
+    out = ara("translate", *args)
+    assert out.returncode == 0
+    assert "note: the model gives this answer a probability of" in out.stderr
+    assert "It reads:" in out.stderr
+    assert json.loads(ara("translate", *args, "--json").stdout)["confidence"] < 0.5
+    out = ara("translate", "at no time (prop_1)", "--aps", "prop_1", "--json")
+    assert json.loads(out.stdout)["confidence"] > 0.9 and "note" not in out.stderr

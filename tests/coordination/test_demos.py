@@ -5,6 +5,7 @@ import json
 import pytest
 
 from ara.coordination.demos import ERRANDS, run_demo
+from ara.eval.confidence import DOUBT
 from ara.eval.coverage import gaps
 from ara.eval.models import FINETUNED_LORA, make_backend
 from ara.eval.translator import Translator
@@ -17,7 +18,8 @@ from conftest import needs_llama
 @pytest.mark.parametrize("name", ["kitting", "tool"])
 def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path):
     """Tests the demo's translation path: the formula it plans from is the repaired
-    translation, and a warning names anything it still leaves out."""
+    translation, a warning names anything it still leaves out, and a note follows a
+    formula the model doubts."""
     if not FINETUNED_LORA.is_file():
         pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
     lines = []
@@ -27,4 +29,6 @@ def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path):
     assert any(line.startswith("[STL, translated by") for line in lines)
     left_out = gaps(errand.nl, tuple(errand.places), parse(result["stl"]))
     assert any(line.startswith("warning:") for line in lines) == bool(left_out)
+    assert 0 < result["confidence"] <= 1  # the model's probability of the formula planned
+    assert any(line.startswith("note:") for line in lines) == (result["confidence"] < DOUBT)
     assert json.loads((tmp_path / f"{name}.json").read_text())["stl"] == result["stl"]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from ara.errors import ConfigError
@@ -95,6 +97,8 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
         translate_repaired(t, nl, aps, samples=-1)
     with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
         translate_repaired(t, nl, aps, by="votes")
+    with pytest.raises(ConfigError, match=r"doubt is a probability, 0 to 1 \(0: gaps only\)"):
+        translate_repaired(t, nl, aps, doubt=2)
 
 
 @needs_llama
@@ -133,7 +137,24 @@ def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
     the grammar could write it."""
     t = Translator(llama_backend, TranslatorConfig(intervals=False))
     nl, aps = "reach (prop_1) within 5 steps", ("prop_1",)
-    vote = translate_repaired(t, nl, aps, samples=3)
+    vote = translate_repaired(t, nl, aps, samples=3, doubt=0)  # gaps only
     left_out = gaps(nl, aps, parse(vote.answers[0]))
     assert left_out.numbers == (5,)
     assert len(vote.results) == (4 if left_out.aps else 1)
+
+
+def test_repair_searches_again_only_where_the_model_doubts_a_complete_answer(finetuned):
+    """Tests repair on answers that leave nothing out: one the model is sure of stands,
+    scored once; one it gives a probability below ``doubt`` is weighed against the
+    samples drawn, and the best-scored complete answer wins, never one the model scores
+    lower than the greedy answer."""
+    t = Translator(finetuned)
+    sure = translate_repaired(t, "at no time ( prop_1 )", ("prop_1",), samples=4)
+    assert sure.answers == ("G(!prop_1)",) and math.exp(sure.scores[0]) > 0.9
+    nl, aps = "( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2")
+    doubted = translate_repaired(t, nl, aps, samples=4, doubt=0.5)
+    assert len(doubted.answers) == 5 and not gaps(nl, aps, parse(doubted.answers[0]))
+    assert math.exp(doubted.scores[0]) < 0.5
+    best = max(s for s in doubted.scores if s is not None)
+    assert doubted.scores[doubted.groups[0][0]] == best >= doubted.scores[0]
+    assert translate_repaired(t, nl, aps, samples=4, doubt=0).answers == doubted.answers[:1]

@@ -21,13 +21,6 @@ NEVER_SEEN = [
 ]
 
 
-@pytest.fixture(scope="module")
-def finetuned(embedded_model_path):
-    if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (scripts/finetune_270m.sh)")
-    return make_backend("finetuned")
-
-
 @pytest.mark.parametrize(("adapter", "version"), [
     (FINETUNED_LORA, "89be643cc979"),  # the soup of v16 and v17, both on generator 3.5.0
     (PAPER_LORA, "1de1d813ead6"),  # the registered paper split

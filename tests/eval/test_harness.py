@@ -43,7 +43,7 @@ def test_config_round_trips_and_refuses_unknown_keys():
 def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
     """Tests that a run without repair writes the config runs wrote before repair
     existed (a resumed run must match it), and that repair round-trips and is bounded."""
-    assert not {"repair", "repair_by"} & set(AblationConfig().to_dict())
+    assert not {"repair", "repair_by", "repair_doubt"} & set(AblationConfig().to_dict())
     repaired = AblationConfig(repair=8)
     assert AblationConfig.from_dict(repaired.to_dict()) == repaired
     assert repaired.repair_by == "samples+edits"
@@ -51,14 +51,26 @@ def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
         AblationConfig(repair=33)
     with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
         AblationConfig(repair=8, repair_by="votes")
+    with pytest.raises(ConfigError, match="repair_doubt is a probability, 0 to 1; got 1.5"):
+        AblationConfig(repair=8, repair_doubt=1.5)
 
 
 def test_a_run_repaired_before_edits_existed_reads_as_repaired_by_samples():
     """Tests that a run folder written when repair only sampled keeps saying so, so that
     resuming it with repair by edits is refused instead of mixing the two."""
     old = AblationConfig(repair=8).to_dict()
-    del old["repair_by"]
+    del old["repair_by"], old["repair_doubt"]
     assert AblationConfig.from_dict(old).repair_by == "samples"
+
+
+def test_a_run_repaired_before_doubt_existed_reads_as_repairing_gaps_only():
+    """Tests that a run folder written when repair acted on gaps alone keeps saying so
+    (doubt 0), so that resuming it under the default, which also acts on answers the
+    model doubts, is refused instead of mixing the two."""
+    old = AblationConfig(repair=8).to_dict()
+    del old["repair_doubt"]
+    assert AblationConfig.from_dict(old).repair_doubt == 0.0
+    assert AblationConfig(repair=8).repair_doubt == 0.5
 
 
 def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):

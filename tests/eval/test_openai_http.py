@@ -66,12 +66,12 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
     """Tests that scoring answers, which repair ranks by, is refused by name on a
     server, and that repair, which can neither score nor sample there, keeps the
     greedy answer of a request it would repair on a local model."""
-    from ara.eval.consistency import can_score, translate_repaired
+    from ara.eval.consistency import translate_repaired
     from ara.eval.coverage import gaps
     from ara.grammars import parse
 
     translator = Translator(OpenAIBackend(server, server="llama"))
-    assert not can_score(translator)
+    assert not translator.can_score
     with pytest.raises(BackendError, match="cannot score answers; use a local model"):
         translator.score("eventually (prop_1)", ["prop_1"], [parse("F(prop_1)")])
     nl, aps = "within 20 steps reach (prop_1), and never (prop_2)", ("prop_1", "prop_2")

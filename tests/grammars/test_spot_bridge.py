@@ -1,6 +1,9 @@
 """Spot checks: hand-checked verdicts, the direction of implication, bounded until."""
 
 import random
+import subprocess
+import sys
+import time
 
 import pytest
 from hypothesis import given, settings
@@ -127,3 +130,37 @@ def test_a_time_limit_turns_a_runaway_check_into_an_error():
     # the worker is replaced and answers the next check
     assert implies(parse("G(a)"), parse("F(a)"), timeout_s=30) is True
     assert equivalent(parse("F(a | F(b))"), parse("F(a) | F(b)"), timeout_s=30) is True
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the worker's tie to its parent is Linux's")
+def test_a_check_does_not_outlive_a_killed_run(tmp_path):
+    """Tests that killing a run in the middle of a long Spot check (as a user's Ctrl-\\ or
+    a scheduler's SIGKILL would) also ends the worker doing the check, which would
+    otherwise run on, for up to an hour and gigabytes."""
+    script = tmp_path / "run.py"
+    script.write_text(
+        "from ara.grammars import parse\n"
+        "from ara.grammars.spot_bridge import _Worker, equivalent\n"
+        "if __name__ == '__main__':\n"
+        "    print(_Worker.get().proc.pid, flush=True)\n"
+        "    equivalent(parse('G(a -> F[20,40](G(c)))'),\n"
+        "               parse('G(a -> F[20,40](G(c))) & F[0,40](b)'), timeout_s=600)\n")
+    run = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    worker = int(run.stdout.readline())
+    time.sleep(1)  # the check is under way
+    assert _alive(worker)
+    run.kill()
+    run.wait()
+    deadline = time.monotonic() + 30
+    while _alive(worker) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _alive(worker)
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not yet reaped, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().split(")")[-1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False

@@ -1,0 +1,51 @@
+"""How sure the shipped fine-tune is of its answers: the flag `ara translate` raises."""
+
+import math
+
+import pytest
+
+from ara.eval.confidence import DOUBT, answer_probability, doubt_warning, winner_probability
+from ara.eval.translator import Translator
+
+
+@pytest.fixture(scope="module")
+def translator(finetuned):
+    return Translator(finetuned)
+
+
+def test_the_model_is_sure_of_a_sentence_it_reads_and_doubts_one_it_cannot(translator):
+    """Tests that the probability of the greedy answer is high for a plain instruction,
+    low for a wrong reading of it, and low for words that say nothing temporal."""
+    nl, aps = "at no time ( prop_1 )", ("prop_1",)
+    answer = translator.translate(nl, aps).stl
+    assert answer == "G(!prop_1)"
+    assert answer_probability(translator, nl, aps, answer) > 0.9
+    assert answer_probability(translator, nl, aps, "F(prop_1)") < DOUBT
+    nonsense, pair = "( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2")
+    probability = answer_probability(translator, nonsense, pair,
+                                     translator.translate(nonsense, pair).stl)
+    assert 0 < probability < DOUBT
+    assert answer_probability(translator, nl, aps, None) is None  # no answer, nothing to score
+
+
+def test_a_repaired_answer_is_scored_as_if_asked_anew(translator):
+    """Tests that the winner's probability taken from repair's scores is the one scoring
+    it afresh gives (a batch rounds differently from feeding a token at a time, so
+    within 0.1 nats), on a request repair acts on."""
+    from ara.eval.consistency import translate_repaired
+
+    nl = "Bring pallet 8 to the loading dock within 250 steps and pallet 9 within 400 steps."
+    aps = ("deliver_pallet_8", "deliver_pallet_9")
+    vote = translate_repaired(translator, nl, aps, samples=8)
+    if len(vote.results) == 1:
+        pytest.skip(f"the greedy answer {vote.result.stl} leaves nothing out: no repair")
+    from_vote = winner_probability(translator, vote)
+    afresh = answer_probability(translator, nl, aps, vote.result.stl)
+    assert abs(math.log(from_vote) - math.log(afresh)) < 0.1
+
+
+def test_the_note_reads_the_answer_back():
+    """Tests the note's wording: the probability, the threshold, the English reading."""
+    note = doubt_warning("F(a & F(b))", 0.0123)
+    assert note.startswith("note: the model gives this answer a probability of 0.012;")
+    assert f"below {DOUBT:g}" in note and 'It reads: "first a, then b".' in note
