@@ -85,7 +85,7 @@ def translate_cmd(
     """
     from ara.data import load_or_prepare
     from ara.data.normalize import form_of
-    from ara.eval.confidence import answer_probability, doubt_warning, winner_probability
+    from ara.eval.confidence import doubt_warning, result_probability, winner_probability
     from ara.eval.coverage import gaps
     from ara.eval.models import default_shots, make_backend
     from ara.eval.prompt import sample_shots
@@ -138,8 +138,8 @@ def translate_cmd(
                                          for x in vote.scores]
     with user_errors():
         probability = (winner_probability(translator, vote, examples, grammar_in_prompt)
-                       if vote else answer_probability(translator, nl, names, result.stl,
-                                                       examples, grammar_in_prompt))
+                       if vote else result_probability(translator, result, examples,
+                                                       grammar_in_prompt))
     data["confidence"] = None if probability is None else round(probability, 3)
     if result.stl is not None:
         gap = gaps(nl, names, parse(result.stl))

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from ara.eval.prompt import Shot
-from ara.eval.translator import Translator
+from ara.eval.translator import TranslationResult, Translator
 from ara.grammars import parse
 from ara.grammars.english import explain
 
@@ -50,16 +50,26 @@ def answer_probability(translator: Translator, nl: str, aps: Sequence[str], stl:
     return math.exp(translator.score(nl, aps, [parse(stl)], shots, grammar_in_prompt)[0])
 
 
+def result_probability(translator: Translator, result: TranslationResult,
+                       shots: Sequence[Shot] = (),
+                       grammar_in_prompt: bool = False) -> float | None:
+    """:func:`answer_probability` of a translation's answer, from the log-probability
+    decoding summed on the way where it has one (no second pass)."""
+    if result.logprob is not None:
+        return math.exp(result.logprob)
+    return answer_probability(translator, result.nl, result.aps, result.stl, shots,
+                              grammar_in_prompt)
+
+
 def winner_probability(translator: Translator, vote: Vote, shots: Sequence[Shot] = (),
                        grammar_in_prompt: bool = False) -> float | None:
     """:func:`answer_probability` of a vote's winner, from the scores repair already
-    has where it scored the winner (the same prompt), else scored now."""
+    has where it scored the winner (the same prompt), else as
+    :func:`result_probability`."""
     score = vote.scores[vote.groups[0][0]] if vote.scores else None
     if score is not None:
         return math.exp(score)
-    winner = vote.result
-    return answer_probability(translator, winner.nl, winner.aps, winner.stl, shots,
-                              grammar_in_prompt)
+    return result_probability(translator, vote.result, shots, grammar_in_prompt)
 
 
 def doubt_warning(stl: str, probability: float) -> str:

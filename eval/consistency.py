@@ -12,10 +12,11 @@ prefers the answers that leave out least; the greedy answer stays unless another
 more of the request. By default the other answers are samples drawn under the grammar
 and the formulas one edit from the greedy one that write what it left out, and the
 model's score of each whole answer picks among them; where the backend cannot score,
-the samples' majority does. A complete greedy answer costs one score: if the model
-gives it a probability below :data:`~ara.eval.confidence.DOUBT`, samples are drawn
-and the best-scored complete answer wins (a search for the likelier answer that greedy
-decoding missed); otherwise it stands.
+the samples' majority does. A complete greedy answer is checked by its score, which
+decoding computes on the way: if the model gives it a probability below
+:data:`~ara.eval.confidence.DOUBT`, samples are drawn and the best-scored complete
+answer wins (a search for the likelier answer that greedy decoding missed); otherwise
+it stands.
 """
 
 from __future__ import annotations
@@ -187,7 +188,8 @@ def _unless_doubted(translator: Translator, greedy: TranslationResult, shots: Se
     nl, aps = greedy.nl, greedy.aps
     if not doubt or not translator.can_score:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
-    (score,) = translator.score(nl, aps, [parse(greedy.stl)], shots, grammar_in_prompt)
+    score = (greedy.logprob if greedy.logprob is not None else  # decoding's own, free
+             translator.score(nl, aps, [parse(greedy.stl)], shots, grammar_in_prompt)[0])
     if math.exp(score) >= doubt:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,

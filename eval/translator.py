@@ -99,6 +99,9 @@ class TranslationResult:
         stop: Why generation ended (``eos``, ``stop``, ``length``).
         masked_steps: Steps where the grammar overruled the model's first choice.
         grammar: Provenance of the decoding grammar (version, hash), if constrained.
+        logprob: The model's log-probability of the answer, as :meth:`Translator.score`
+            gives it, where decoding wrote the formula's canonical text in the
+            tokenizer's own tokens (nearly always); else ``None``: score it.
     """
 
     nl: str
@@ -118,6 +121,7 @@ class TranslationResult:
     stop: str
     masked_steps: int
     grammar: dict = field(default_factory=dict)
+    logprob: float | None = None
 
     def to_dict(self) -> dict:
         data = asdict(self)
@@ -271,6 +275,9 @@ class Translator:
             cached_tokens=completion.cached_tokens, ms=completion.ms, stop=completion.stop,
             masked_steps=completion.masked_steps,
             grammar=built.provenance() if constrained else {},
+            # what scoring feeds: the canonical text, then the end of the answer
+            logprob=(completion.logprob if stl is not None and completion.text
+                     == ANSWER_PREFIX + stl + STOP else None),
         )
 
     @property

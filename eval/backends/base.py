@@ -38,6 +38,9 @@ class Completion:
             (token budget spent).
         masked_steps: Steps at which the model's first choice broke the grammar and the
             mask was computed (constrained decoding only).
+        logprob: The model's log-probability of ``text`` (scores before any mask), where
+            the tokens generated are the tokenizer's own for ``text``; else ``None``, as
+            from a server.
     """
 
     text: str
@@ -47,6 +50,7 @@ class Completion:
     ms: float
     stop: str
     masked_steps: int = 0
+    logprob: float | None = None
 
 
 @dataclass(frozen=True)

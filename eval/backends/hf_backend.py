@@ -128,11 +128,13 @@ class HFBackend:
         ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
         logits, reused = self._feed_prompt(ids)
         matcher = GrammarMatcher(self.lltokenizer, grammar) if grammar is not None else None
-        text, out, reason = greedy_decode(
+        text, out, reason, logprob = greedy_decode(
             logits, lambda token: self._forward([token]), self.tokenizer.decode, matcher,
             self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
+        own = self.tokenizer(text, add_special_tokens=False)["input_ids"] == out
         return Completion(text, len(ids), len(out), reused, (time.perf_counter() - start) * 1e3,
-                          reason, matcher.masked_steps if matcher else 0)
+                          reason, matcher.masked_steps if matcher else 0,
+                          logprob if own else None)
 
     def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
         """Log-probability of each continuation after ``prompt``, teacher-forced without a

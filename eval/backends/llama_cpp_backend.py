@@ -125,13 +125,19 @@ class LlamaCppBackend:
             self.llm.eval([token])
             return self._logits()
 
-        text, out, reason = greedy_decode(
+        text, out, reason, logprob = greedy_decode(
             self._logits(), advance,
             lambda ids: self.llm.detokenize(ids).decode("utf-8", errors="replace"),
             matcher, self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
         return Completion(text, len(tokens), len(out), reused,
                           (time.perf_counter() - start) * 1e3, reason,
-                          matcher.masked_steps if matcher else 0)
+                          matcher.masked_steps if matcher else 0,
+                          logprob if self._is_own_tokenization(text, out) else None)
+
+    def _is_own_tokenization(self, text: str, tokens: list[int]) -> bool:
+        """Whether ``tokens`` are how the tokenizer writes ``text``, so that their
+        log-probability is the one scoring ``text`` gives."""
+        return self.llm.tokenize(text.encode(), add_bos=False, special=False) == tokens
 
     def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
         """Log-probability of each continuation after ``prompt``, teacher-forced without a

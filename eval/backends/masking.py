@@ -75,7 +75,7 @@ class Sampler:
 def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
                   detokenize: Callable[[list[int]], str], matcher: GrammarMatcher | None,
                   eos: set[int], max_tokens: int, stop: str,
-                  sampler: Sampler | None = None) -> tuple[str, list[int], str]:
+                  sampler: Sampler | None = None) -> tuple[str, list[int], str, float]:
     """The decoding loop both local backends share: greedy, or sampled with ``sampler``.
 
     Args:
@@ -89,23 +89,35 @@ def greedy_decode(logits: np.ndarray, advance: Callable[[int], np.ndarray],
         sampler: Draw each token instead of taking the argmax.
 
     Returns:
-        ``(text, tokens, reason)`` with reason ``eos``, ``stop`` or ``length``.
+        ``(text, tokens, reason, logprob)`` with reason ``eos``, ``stop`` or ``length``,
+        and ``logprob`` the model's log-probability of ``tokens`` from the scores before
+        any mask: what :func:`score_paths` gives the same tokens, without a second pass
+        (the end-of-text token is not counted, as scoring does not feed it).
     """
     out: list[int] = []
     text = ""
+    logprob = 0.0
     for _ in range(max_tokens):
         if matcher is not None:
             token = matcher.choose(logits, sampler)
         else:
             token = int(np.argmax(logits)) if sampler is None else sampler(logits)
         if token in eos:
-            return text, out, "eos"
+            return text, out, "eos", logprob
         out.append(token)
+        logprob += _log_softmax_at(logits, token)
         text = detokenize(out)
         if matcher is None and stop in text:
-            return text[: text.index(stop)], out, "stop"
+            return text[: text.index(stop)], out, "stop", logprob
         logits = advance(token)
-    return text, out, "length"
+    return text, out, "length", logprob
+
+
+def _log_softmax_at(row: np.ndarray, token: int) -> float:
+    """``log_softmax(row)[token]``, in float64."""
+    row = row.astype(np.float64)
+    top = row.max()
+    return float(row[token] - top - np.log(np.exp(row - top).sum()))
 
 
 def score_paths(prompt: Sequence[int], paths: Sequence[Sequence[int]],
@@ -136,9 +148,7 @@ def score_paths(prompt: Sequence[int], paths: Sequence[Sequence[int]],
             start = len(prompt) + shared - 1
             feed = [*prompt, *path][start: len(prompt) + len(path) - 1]
             for row, token in zip(rows(start, feed), path[shared:], strict=True):
-                row = row.astype(np.float64)
-                top = row.max()
-                logp.append(float(row[token] - top - np.log(np.exp(row - top).sum())))
+                logp.append(_log_softmax_at(row, token))
         totals[i] = sum(logp)
         done, done_logp = path, logp
     return totals

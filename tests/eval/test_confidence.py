@@ -49,3 +49,22 @@ def test_the_note_reads_the_answer_back():
     note = doubt_warning("F(a & F(b))", 0.0123)
     assert note.startswith("note: the model gives this answer a probability of 0.012;")
     assert f"below {DOUBT:g}" in note and 'It reads: "first a, then b".' in note
+
+
+def test_decoding_scores_its_answer_on_the_way(translator):
+    """Tests that the log-probability decoding sums while it writes an answer is the
+    one scoring the answer afterwards gives, so the check on every answer costs no
+    second pass (within half a nat: llama.cpp multiplies a batch by the quantized
+    weights with other kernels than one token, 0.25 apart on the third sentence)."""
+    from ara.grammars import parse
+
+    for nl, aps in [("at no time ( prop_1 )", ("prop_1",)),
+                    ("Keep away from the stairs at all times and eventually reach the garden.",
+                     ("at_garden", "at_stairs")),
+                    ("( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2"))]:
+        result = translator.translate(nl, aps)
+        assert result.logprob is not None, result.raw  # the tokenizer's own tokens
+        scored = translator.score(nl, aps, [parse(result.stl)])[0]
+        assert result.logprob == pytest.approx(scored, abs=0.5)
+    free = translator.translate("at no time ( prop_1 )", ("prop_1",), constrained=False)
+    assert free.logprob is None  # free decoding stops at the newline it does not keep

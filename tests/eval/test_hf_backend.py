@@ -62,3 +62,19 @@ def test_transformers_and_llama_cpp_score_answers_alike(hf_backend, llama_backen
                " G(!door) & F(door)\n"]
     assert hf_backend.score(prompt, answers) == pytest.approx(
         llama_backend.score(prompt, answers), abs=1.5)
+
+
+def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backend):
+    """Tests that a completion's log-probability, summed while decoding, is what scoring
+    its text gives, in both runtimes (the free check `ara translate` runs on every
+    answer)."""
+    from ara.grammars import parse
+
+    for backend in (hf_backend, llama_backend):
+        t = Translator(backend)
+        nl, aps = "always avoid the door and eventually reach the goal", ("door", "goal")
+        result = t.translate(nl, aps)
+        if result.logprob is None:
+            pytest.skip(f"{result.raw!r} was not written in the tokenizer's own tokens")
+        assert result.logprob == pytest.approx(
+            t.score(nl, aps, [parse(result.stl)])[0], abs=0.5)
