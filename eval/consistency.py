@@ -166,12 +166,8 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
         if drawn or mends:
             results = [greedy, *drawn, *(replace(greedy, raw=ANSWER_PREFIX + text, stl=text)
                                          for text in mends)]
-            answers = [r.stl for r in results]
-            missing = [_missing(nl, aps, a, bounds) for a in answers]
-            scores = score_complete(translator, nl, aps, answers, missing, shots,
-                                    grammar_in_prompt)
-            return Vote(tuple(results), _same_text(results, rank_scored(missing, scores)),
-                        (time.perf_counter() - start) * 1e3, tuple(scores))
+            return _ranked_by_score(translator, results, shots, grammar_in_prompt,
+                                    greedy_stays=True, start=start)
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
                               grammar_in_prompt)]
     ranked = rank_repairs([r.stl for r in results],
@@ -194,11 +190,20 @@ def _unless_doubted(translator: Translator, greedy: TranslationResult, shots: Se
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
                               grammar_in_prompt)]
+    return _ranked_by_score(translator, results, shots, grammar_in_prompt,
+                            greedy_stays=False, start=start)
+
+
+def _ranked_by_score(translator: Translator, results: Sequence[TranslationResult],
+                     shots: Sequence[Shot], grammar_in_prompt: bool, greedy_stays: bool,
+                     start: float) -> Vote:
+    """A vote over ``results`` (greedy first) by the model's score of those that leave
+    out least (:func:`score_complete`, :func:`rank_scored`), grouped by text."""
+    nl, aps = results[0].nl, results[0].aps
     answers = [r.stl for r in results]
-    bounds = translator.config.intervals
-    missing = [_missing(nl, aps, a, bounds) for a in answers]
+    missing = [_missing(nl, aps, a, translator.config.intervals) for a in answers]
     scores = score_complete(translator, nl, aps, answers, missing, shots, grammar_in_prompt)
-    order = rank_scored(missing, scores, greedy_stays=False)
+    order = rank_scored(missing, scores, greedy_stays)
     return Vote(tuple(results), _same_text(results, order),
                 (time.perf_counter() - start) * 1e3, tuple(scores))
 

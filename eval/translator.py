@@ -294,13 +294,12 @@ class Translator:
         Raises:
             BackendError: If the backend cannot score (an HTTP server).
         """
-        score = getattr(self.backend, "score", None)
-        if score is None:
+        if not self.can_score:
             raise BackendError(f"{type(self.backend).__name__} cannot score answers; "
                                "use a local model (llama.cpp or transformers)")
         prompt = self._prompt(nl, tuple(aps), shots, grammar_in_prompt,
                               self.grammar(aps, nl).syntax)
-        return score(prompt, [ANSWER_PREFIX + to_text(f) + STOP for f in formulas])
+        return self.backend.score(prompt, [ANSWER_PREFIX + to_text(f) + STOP for f in formulas])
 
     @staticmethod
     def _prompt(nl: str, aps: tuple[str, ...], shots: Sequence[Shot], grammar_in_prompt: bool,

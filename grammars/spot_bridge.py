@@ -242,8 +242,9 @@ def _die_with(parent: int) -> None:
 
     ``daemon=True`` only covers a parent that exits normally; a run killed by a signal
     would leave a check running in Spot's C++, which holds the GIL and can take an hour
-    and gigabytes. Linux ties the signal to the thread that started the worker; if
-    that thread ends first, the next check starts a new worker.
+    and gigabytes. Linux ties the signal to the thread that started the worker: if
+    that thread ends first, a check in flight fails and the next one starts a new
+    worker (checks run on the thread that judges, the main one, in this project).
     """
     if sys.platform != "linux":
         return
