@@ -10,7 +10,7 @@ from ara import __version__
 from ara.coordination.cli import coord_app
 from ara.data.cli import data_app
 from ara.demo import demo_cmd
-from ara.eval.cli import eval_app, translate_cmd
+from ara.eval.cli import eval_app, translate_cmd, translate_file_cmd
 from ara.grammars.cli import grammar_cmd, stl_app
 from ara.training.cli import export_cmd, model_app, soup_cmd, train_cmd
 
@@ -26,6 +26,7 @@ app.add_typer(eval_app, name="eval")
 app.add_typer(model_app, name="model")
 app.add_typer(coord_app, name="coord")
 app.command("translate")(translate_cmd)
+app.command("translate-file")(translate_file_cmd)
 app.command("grammar")(grammar_cmd)
 app.command("demo")(demo_cmd)
 app.command("train")(train_cmd)

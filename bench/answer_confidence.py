@@ -6,6 +6,9 @@
     .venv/bin/python bench/answer_confidence.py \
         --runs 'docs/results/generalization/soup-v16v17-270m/[ht]*' --resample 8 \
         --out docs/results/answer-confidence-resampled.json
+    .venv/bin/python bench/answer_confidence.py \
+        --runs 'docs/results/generalization/soup-v16v17-270m/[ht]*' --readings 3 \
+        --out docs/results/answer-confidence-readings.json
 
 Scores every zero-shot constrained (C) answer in the run folders with ``--model`` (the
 model that gave them: the bench refuses folders run with another), judged right or
@@ -19,7 +22,13 @@ whether flagged answers can be fixed without a reference: each answer below DOUB
 translated again with self-consistency (greedy + K samples, the largest group by
 meaning wins; :func:`~ara.eval.consistency.translate_consistent`) and judged; Spot
 takes minutes to group the samples of a long compositional formula, hence the second
-command's narrower glob (the hand-written suites and the timed set).
+command's narrower glob (the hand-written suites and the timed set). ``--readings K``
+asks what a user who is shown the other readings gains: each answer below DOUBT is
+translated again as ``ara translate`` does by default (repair by samples and edits,
+:func:`~ara.eval.consistency.translate_repaired`), and the winner and up to K other
+readings it weighed (:func:`~ara.eval.consistency.readings`, what ``ara translate
+--alternatives`` lists) are judged: how often the right one is first, among the first
+two, and so on.
 """
 
 from __future__ import annotations
@@ -28,6 +37,7 @@ import argparse
 import fnmatch
 import glob
 import json
+import math
 import os
 import platform
 from datetime import date
@@ -36,7 +46,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ara.eval.confidence import DOUBT, answer_probability
-from ara.eval.consistency import translate_consistent
+from ara.eval.consistency import DEFAULT_REPAIR, readings, translate_consistent, translate_repaired
 from ara.eval.harness import judge
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator
@@ -66,6 +76,16 @@ def flag_table(records: list[dict]) -> list[dict]:
     return rows
 
 
+def readings_table(records: list[dict], others: int) -> dict:
+    """How many of the flagged answers have the right reading first, among the first
+    two, ..., among the first ``1 + others`` (``right_within[k - 1]``)."""
+    return {"flagged": len(records),
+            "right_within": [sum(any(x["right"] for x in r["readings"][:k]) for r in records)
+                             for k in range(1, 2 + others)],
+            "shown": [sum(len(r["readings"]) >= k for r in records)
+                      for k in range(1, 2 + others)]}
+
+
 def print_table(name: str, records: list[dict]) -> None:
     n = len(records)
     print(f"\n{name}: {n} answers, {sum(r['right'] for r in records)} right")
@@ -80,7 +100,7 @@ def print_table(name: str, records: list[dict]) -> None:
 
 
 def score_folder(translator: Translator, folder: Path, timeout_s: float,
-                 resample: int) -> list[dict]:
+                 resample: int, others: int) -> list[dict]:
     records = []
     rows = [json.loads(line) for line in (folder / "samples.jsonl").read_text().splitlines()]
     for r in tqdm([r for r in rows if r["variant"] == "C" and r["stl"]], desc=folder.name,
@@ -96,6 +116,13 @@ def score_folder(translator: Translator, folder: Path, timeout_s: float,
                                         timeout_s=timeout_s)
             record["resampled"] = {"stl": vote.result.stl, "right": bool(
                 judge(r["reference"], vote.result.stl, timeout_s)["equivalent"])}
+        if others and record["probability"] < DOUBT:
+            vote = translate_repaired(translator, r["nl"], r["aps"], samples=DEFAULT_REPAIR,
+                                      timeout_s=timeout_s)
+            record["readings"] = [
+                {"stl": stl, "probability": math.exp(score),
+                 "right": bool(judge(r["reference"], stl, timeout_s)["equivalent"])}
+                for stl, score in readings(vote, timeout_s, limit=1 + others)]
         records.append(record)
     return records
 
@@ -110,6 +137,9 @@ def main() -> None:
                         help="The model that gave the answers (any --model value).")
     parser.add_argument("--resample", type=int, default=0,
                         help="Translate flagged answers again with greedy + K samples.")
+    parser.add_argument("--readings", type=int, default=0,
+                        help="Translate flagged answers again with repair (ara translate's "
+                             "default) and judge the winner and up to K other readings.")
     parser.add_argument("--spot-timeout", type=float, default=5.0)
     parser.add_argument("--out", type=Path, default=Path("docs/results/answer-confidence.json"))
     args = parser.parse_args()
@@ -123,7 +153,8 @@ def main() -> None:
             parser.error(f"{folder} was run with {ran}, not --model {args.model} "
                          f"({translator.backend.model_id}): pass the model that gave the answers")
     records = [rec for folder in folders
-               for rec in score_folder(translator, folder, args.spot_timeout, args.resample)]
+               for rec in score_folder(translator, folder, args.spot_timeout, args.resample,
+                                       args.readings)]
     areas = {}
     for name in sorted({r["set"] for r in records}) + ["all"]:
         chosen = [r for r in records if name in ("all", r["set"])]
@@ -149,10 +180,16 @@ def main() -> None:
         print(f"flagged answers translated again with {args.resample} samples: "
               f"{summary['resampled']['resampled_right']} right of {len(redone)} "
               f"(greedy {summary['resampled']['greedy_right']})")
+    if args.readings:
+        for name, chosen in (("dev (" + args.dev + ")", dev), ("the other folders", held)):
+            summary.setdefault("readings", {})[name] = found = readings_table(
+                [r for r in chosen if "readings" in r], args.readings)
+            print(f"\n{name}: flagged answers translated again, right among the first k "
+                  f"readings: {found}")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps({
         "command": f"bench/answer_confidence.py --runs '{args.runs}' --dev '{args.dev}' "
-                   f"--model {args.model} --resample {args.resample} "
+                   f"--model {args.model} --resample {args.resample} --readings {args.readings} "
                    f"--spot-timeout {args.spot_timeout:g}",
         "date": date.today().isoformat(),
         "machine": f"{platform.platform()}, {os.cpu_count()} cores",

@@ -15,8 +15,9 @@ with the default grammar, so a candidate is timed beside what ships, in the same
 by samples+edits (the default; it also draws for a complete answer the model doubts),
 by edits and by samples: its median is the greedy answer's, its mean carries the extra
 work for the few it acts on. The row "ara translate" is what the command does by
-default: repair, then the model's probability of the answer it gives (the confidence
-note; free where repair scored the answer already).
+default (:func:`~ara.eval.answering.answer`): repair, the model's probability of the
+answer it gives (the confidence note; free where repair scored the answer already), and
+for a doubted answer the other readings it weighed (Spot checks between them).
 """
 
 from __future__ import annotations
@@ -29,22 +30,28 @@ import statistics
 import time
 
 from ara.data import load_or_prepare
-from ara.eval.confidence import winner_probability
+from ara.eval.answering import answer
 from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator, TranslatorConfig
 
 
 def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0],
-            confidence: bool = False) -> dict:
+            command: bool = False) -> dict:
     translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
+    if command:  # what `ara translate` does, as it does it
+        ms = []
+        for r in records:
+            start = time.perf_counter()
+            answer(translator, r.nl, r.aps)
+            ms.append((time.perf_counter() - start) * 1e3)
+        return {"median_ms": statistics.median(ms), "mean_ms": statistics.fmean(ms),
+                "tokens": None}
     if repair:
         runs, ms = [], []
         for r in records:
             start = time.perf_counter()
             vote = translate_repaired(translator, r.nl, r.aps, samples=repair, by=by)
-            if confidence:  # what `ara translate` adds for its note
-                winner_probability(translator, vote)
             runs.append(vote.result)
             ms.append((time.perf_counter() - start) * 1e3)
     else:
@@ -76,7 +83,8 @@ def main() -> None:
             *[("finetuned", TranslatorConfig(), f"--repair {args.repair} --repair-by {by}",
                "bounds the sentence writes", (args.repair, by))
               for by in REPAIR_BY if args.repair],
-            *[("finetuned", TranslatorConfig(), "ara translate: repair and confidence",
+            *[("finetuned", TranslatorConfig(),
+               "ara translate: repair, confidence, other readings",
                "bounds the sentence writes", (args.repair, REPAIR_BY[0], True))
               for _ in range(bool(args.repair))],
             ("finetuned", TranslatorConfig(bounds_from_request=False), "--any-bound",
@@ -90,8 +98,9 @@ def main() -> None:
         t = Translator(make_backend(model), config)
         m = measure(t, records, *(repair or (0,)))
         base = base or m["median_ms"]
+        tokens = "-" if m["tokens"] is None else f"{m['tokens']:.1f}"
         print(f"| {model} ({label}) | {grammar} | "
-              f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {m['tokens']:.1f} | "
+              f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {tokens} | "
               f"{m['median_ms'] / base:.2f} |", flush=True)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import random
 import signal
 from pathlib import Path
@@ -12,7 +13,7 @@ from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
 from ara.eval.confidence import DOUBT
 from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
-from ara.eval.consistency import REPAIR_BY, translate_consistent, translate_repaired
+from ara.eval.consistency import REPAIR_BY
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -25,55 +26,90 @@ SERVER_HELP = ("With an http(s):// --model: the server that runs it, which says 
                "vllm, sglang, or openai (no grammar; constrained variants are refused).")
 
 
+# The options ``ara translate`` and ``ara translate-file`` share, defined once.
+MODEL = typer.Option("finetuned", "--model", help=MODEL_HELP)
+SHOTS = typer.Option(
+    None, "--shots", min=0, max=50,
+    help="Worked examples from the compositional train side; default 0 for the "
+         "fine-tuned adapters, 5 for other models.")
+SEED = typer.Option(0, "--seed", help="Which worked examples, and the samples' seeds.")
+INTERVALS = typer.Option(
+    True, "--intervals/--no-intervals",
+    help="Allow time bounds (F[a,b], G[a,b], U[a,b]); on by default, and an untimed "
+         "sentence still comes out untimed.")
+MAX_BOUND = typer.Option(1000, "--max-bound", min=1,
+                         help="Largest time bound the grammar admits.")
+ANY_BOUND = typer.Option(
+    False, "--any-bound",
+    help="Let intervals use any number up to --max-bound; by default they use only 0 "
+         "and the numbers the sentence writes (digits, or words up to 'hundred').")
+TEMPERATURE = typer.Option(0.7, "--temperature", min=0.01,
+                           help="Sampling temperature for --samples and --repair.")
+REPAIR_OPTION = typer.Option(
+    None, "--repair", min=0, max=32,
+    help=f"When the greedy answer leaves out a proposition in --aps or a number the "
+         f"sentence states as time, look for an answer that leaves out less (a "
+         f"complete greedy answer costs nothing more), drawing K answers under the "
+         f"grammar (see --repair-by). Default {REPAIR}, or 0 with --samples; 0: off.")
+REPAIR_BY_OPTION = typer.Option(
+    REPAIR_BY[0], "--repair-by",
+    help="samples+edits: the K answers drawn and the formulas one edit from the "
+         "greedy answer that write what it left out; the one the model scores "
+         "highest of those that leave out least wins. edits: the edits alone. "
+         "samples: the majority of the K drawn that leave out least (also what the "
+         "others do with an HTTP --model, which cannot score).")
+DOUBT_OPTION = typer.Option(
+    DOUBT, "--doubt", min=0.0, max=1.0,
+    help="With repair by samples+edits: also draw the K answers when the greedy "
+         "answer leaves nothing out but the model gives it a probability below this, "
+         "and keep the best-scored complete one. 0: repair answers with a gap only.")
+ALTERNATIVES = typer.Option(
+    2, "--alternatives", min=0, max=8,
+    help="When the model doubts its answer, list up to this many other readings it "
+         "weighed (distinct meanings of the answers repair drew, best-scored first), "
+         "each read back in English. 0: none.")
+SERVER = typer.Option("openai", "--server", help=SERVER_HELP)
+
+
+def worked_examples(model: str, shots: int | None, aps: tuple[str, ...], seed: int) -> list:
+    """The worked examples a prompt for ``aps`` shows: ``shots`` of them (``None``: the
+    model's default) from the compositional train side, of the propositions' form."""
+    from ara.data import load_or_prepare
+    from ara.data.normalize import form_of
+    from ara.eval.models import default_shots
+    from ara.eval.prompt import sample_shots
+
+    k = shots if shots is not None else default_shots(model)
+    if not k:
+        return []
+    pool = load_or_prepare("compositional").records("train", form_of(aps))
+    return sample_shots(pool, k, random.Random(seed))
+
+
 def translate_cmd(
     nl: str = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'."),
     aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, each "
                             "named in the sentence (go_to_kitchen: 'go to the kitchen')."),
-    model: str = typer.Option("finetuned", "--model", help=MODEL_HELP),
+    model: str = MODEL,
     no_constraint: bool = typer.Option(False, "--no-constraint",
                                        help="Decode freely instead of under the grammar."),
     grammar_in_prompt: bool = typer.Option(False, "--grammar-in-prompt",
                                            help="Show the grammar in the prompt."),
-    shots: int | None = typer.Option(
-        None, "--shots", min=0, max=50,
-        help="Worked examples from the compositional train side; default 0 for the "
-             "fine-tuned adapters, 5 for other models."),
-    seed: int = typer.Option(0, "--seed", help="Which worked examples."),
-    intervals: bool = typer.Option(
-        True, "--intervals/--no-intervals",
-        help="Allow time bounds (F[a,b], G[a,b], U[a,b]); on by default, and an untimed "
-             "sentence still comes out untimed."),
-    max_bound: int = typer.Option(1000, "--max-bound", min=1,
-                                  help="Largest time bound the grammar admits."),
-    any_bound: bool = typer.Option(
-        False, "--any-bound",
-        help="Let intervals use any number up to --max-bound; by default they use only 0 "
-             "and the numbers the sentence writes (digits, or words up to 'hundred')."),
+    shots: int | None = SHOTS,
+    seed: int = SEED,
+    intervals: bool = INTERVALS,
+    max_bound: int = MAX_BOUND,
+    any_bound: bool = ANY_BOUND,
     samples: int = typer.Option(
         1, "--samples", min=1, max=32,
         help="Self-consistency: K answers under the grammar (greedy + K-1 sampled), "
              "grouped by Spot equivalence; the largest group wins. 1: greedy."),
-    temperature: float = typer.Option(0.7, "--temperature", min=0.01,
-                                      help="Sampling temperature for --samples and --repair."),
-    repair: int | None = typer.Option(
-        None, "--repair", min=0, max=32,
-        help=f"When the greedy answer leaves out a proposition in --aps or a number the "
-             f"sentence states as time, look for an answer that leaves out less (a "
-             f"complete greedy answer costs nothing more), drawing K answers under the "
-             f"grammar (see --repair-by). Default {REPAIR}, or 0 with --samples; 0: off."),
-    repair_by: str = typer.Option(
-        REPAIR_BY[0], "--repair-by",
-        help="samples+edits: the K answers drawn and the formulas one edit from the "
-             "greedy answer that write what it left out; the one the model scores "
-             "highest of those that leave out least wins. edits: the edits alone. "
-             "samples: the majority of the K drawn that leave out least (also what the "
-             "others do with an HTTP --model, which cannot score)."),
-    doubt: float = typer.Option(
-        DOUBT, "--doubt", min=0.0, max=1.0,
-        help="With repair by samples+edits: also draw the K answers when the greedy "
-             "answer leaves nothing out but the model gives it a probability below this, "
-             "and keep the best-scored complete one. 0: repair answers with a gap only."),
-    server: str = typer.Option("openai", "--server", help=SERVER_HELP),
+    temperature: float = TEMPERATURE,
+    repair: int | None = REPAIR_OPTION,
+    repair_by: str = REPAIR_BY_OPTION,
+    doubt: float = DOUBT_OPTION,
+    alternatives: int = ALTERNATIVES,
+    server: str = SERVER,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Translate one instruction into STL over the given propositions.
@@ -81,74 +117,118 @@ def translate_cmd(
     Prints the formula. On stderr: a warning when it leaves out a listed
     proposition or a stated bound, and a note with the formula read back in
     English when the model gives its answer a probability below 0.5 (about
-    half of such held-out answers were wrong). --json has it as "confidence".
+    half of such held-out answers were wrong), with the other readings it
+    weighed. --json has them as "confidence" and "alternatives".
     """
-    from ara.data import load_or_prepare
-    from ara.data.normalize import form_of
-    from ara.eval.confidence import doubt_warning, result_probability, winner_probability
-    from ara.eval.coverage import gaps
-    from ara.eval.models import default_shots, make_backend
-    from ara.eval.prompt import sample_shots
+    from ara.eval.answering import AnswerConfig, answer, doubted
+    from ara.eval.confidence import doubt_warning
+    from ara.eval.coverage import Gaps
+    from ara.eval.models import make_backend
     from ara.eval.translator import Translator, TranslatorConfig, check_request
-    from ara.grammars import parse
 
     with user_errors():
         names = split_list(aps)
         config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
                                   bounds_from_request=not any_bound)
         check_request(nl, names, config)
-        if samples > 1 and no_constraint:
-            raise ConfigError("--samples decodes under the grammar (every sample valid); "
-                              "drop --no-constraint")
-        if samples > 1 and repair:
-            raise ConfigError("--samples and --repair are two ways to spend extra answers; "
-                              "pass one")
-        if repair and no_constraint:
-            raise ConfigError("--repair decodes under the grammar; drop --no-constraint")
-        if repair_by not in REPAIR_BY:
-            raise ConfigError(f"--repair-by {repair_by!r}? choose one of {', '.join(REPAIR_BY)}")
-        if repair is None:
-            repair = 0 if samples > 1 or no_constraint else REPAIR
-        k = shots if shots is not None else default_shots(model)
-        pool = load_or_prepare("compositional").records("train", form_of(names))
-        examples = sample_shots(pool, k, random.Random(seed)) if k else []
+        how = AnswerConfig(samples=samples, repair=repair, repair_by=repair_by, doubt=doubt,
+                           temperature=temperature, seed=seed,
+                           grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
+                           alternatives=alternatives)
+        examples = worked_examples(model, shots, names, seed)
         translator = Translator(make_backend(model, server=server), config)
-        vote = None
-        if samples > 1:
-            vote = translate_consistent(translator, nl, names, examples, samples, temperature,
-                                        seed, grammar_in_prompt=grammar_in_prompt)
-            result = vote.result
-        elif repair:
-            vote = translate_repaired(translator, nl, names, examples, repair, temperature,
-                                      seed, grammar_in_prompt=grammar_in_prompt, by=repair_by,
-                                      doubt=doubt)
-            result = vote.result
-        else:
-            result = translator.translate(nl, names, examples, grammar_in_prompt,
-                                          constrained=not no_constraint)
-    data = {"stl": result.stl, "valid": result.valid, "raw": result.raw,
-            "ms": round(vote.ms if vote else result.ms, 1), "error": result.error,
-            "model": translator.backend.model_id, "constrained": result.constrained,
-            "shots": k, "grammar": result.grammar}
-    if vote is not None:
-        data["samples"] = {"answers": list(vote.answers), "groups": [list(g) for g in vote.groups],
-                           "agreement": round(vote.agreement, 3)}
-        if vote.scores:
-            data["samples"]["scores"] = [None if x is None else round(x, 3)
-                                         for x in vote.scores]
-    with user_errors():
-        probability = (winner_probability(translator, vote, examples, grammar_in_prompt)
-                       if vote else result_probability(translator, result, examples,
-                                                       grammar_in_prompt))
-    data["confidence"] = None if probability is None else round(probability, 3)
-    if result.stl is not None:
-        gap = gaps(nl, names, parse(result.stl))
-        data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
-        if gap and not as_json:
+        data = answer(translator, nl, names, examples, how)
+    if not as_json and "left_out" in data:
+        gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]))
+        if gap:
             typer.echo(gap.warning(), err=True)
-        if probability is not None and probability < DOUBT and not as_json:
-            typer.echo(doubt_warning(result.stl, probability), err=True)
+        if doubted(data):
+            others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
+            typer.echo(doubt_warning(data["stl"], data["confidence"], others), err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
+
+
+def translate_file_cmd(
+    requests: Path = typer.Argument(
+        ..., help='JSON Lines, one request per line: {"nl": "...", "aps": ["a", "b"]}, '
+                  'optionally "stl" (a reference, judged by Spot) and "id".'),
+    out: Path = typer.Option(..., "--out", help="JSON Lines: each request with its answer "
+                             "(the object of ara translate --json), written as it is made."),
+    resume: bool = typer.Option(False, "--resume",
+                                help="Go on with an --out an interrupted run left."),
+    model: str = MODEL,
+    shots: int | None = SHOTS,
+    seed: int = SEED,
+    intervals: bool = INTERVALS,
+    max_bound: int = MAX_BOUND,
+    any_bound: bool = ANY_BOUND,
+    temperature: float = TEMPERATURE,
+    repair: int | None = REPAIR_OPTION,
+    repair_by: str = REPAIR_BY_OPTION,
+    doubt: float = DOUBT_OPTION,
+    alternatives: int = ALTERNATIVES,
+    spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
+                                       help="Seconds per Spot check against a reference."),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Show a progress bar on stderr."),
+    server: str = SERVER,
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+) -> None:
+    """Translate a file of instructions as ara translate would, loading the model once.
+
+    Every line is checked first (a bad line stops the run before any
+    translation, naming its line). Answers are appended to --out one line
+    each as they are made, so an interrupted run loses nothing: rerun with
+    --resume. At the end a summary: how many answers are valid, doubted
+    (confidence below 0.5), leave part of the request out, and, for lines
+    with a reference, how many are Spot-equivalent to it.
+    """
+    from tqdm import tqdm
+
+    from ara.eval.answering import AnswerConfig
+    from ara.eval.batch import (
+        done_lines,
+        read_requests,
+        summarize,
+        summary_table,
+        translate_requests,
+    )
+    from ara.eval.models import make_backend
+    from ara.eval.translator import Translator, TranslatorConfig
+
+    with user_errors():
+        config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
+                                  bounds_from_request=not any_bound)
+        todo = read_requests(requests, config)
+        how = AnswerConfig(repair=repair, repair_by=repair_by, doubt=doubt,
+                           temperature=temperature, seed=seed, alternatives=alternatives)
+        if out.exists() and out.stat().st_size and not resume:
+            raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
+                              "another --out")
+        translator = Translator(make_backend(model, server=server), config)
+        done = done_lines(out, todo, translator.backend.model_id)
+        examples: dict[tuple[str, ...], list] = {}
+
+        def shots_for(aps: tuple[str, ...]) -> list:
+            if aps not in examples:
+                examples[aps] = worked_examples(model, shots, aps, seed)
+            return examples[aps]
+
+        if done:
+            typer.echo(f"resuming {out} after {done} of {len(todo)} answers", err=True)
+        rows = translate_requests(translator, todo[done:], out, shots_for, how, spot_timeout)
+        try:
+            for _ in tqdm(rows, total=len(todo), initial=done, unit="request",
+                          disable=not progress):
+                pass
+        except KeyboardInterrupt:
+            kept = len(out.read_text(encoding="utf-8").splitlines())
+            typer.echo(f"\ninterrupted: {kept} of {len(todo)} answers are in {out}; run the "
+                       "same command with --resume to go on", err=True)
+            raise typer.Exit(130) from None
+    lines = [json.loads(line) for line in out.read_text(encoding="utf-8").splitlines()]
+    summary = summarize(lines)
+    emit(summary, as_json, lambda s: summary_table(s) + f"\n\nanswers in {out}")
 
 
 @eval_app.command("ablation")

@@ -72,9 +72,16 @@ def winner_probability(translator: Translator, vote: Vote, shots: Sequence[Shot]
     return result_probability(translator, vote.result, shots, grammar_in_prompt)
 
 
-def doubt_warning(stl: str, probability: float) -> str:
-    """What to tell a user whose answer the model doubts, with the answer read back."""
-    return (f"note: the model gives this answer a probability of {probability:.2g}; below "
-            f"{DOUBT:g}, about half of its answers on held-out sentences were wrong. It "
-            f"reads: \"{explain(parse(stl))}\". If that is not what you meant, reword the "
-            "sentence.")
+def doubt_warning(stl: str, probability: float,
+                  others: Sequence[tuple[str, float]] = ()) -> str:
+    """What to tell a user whose answer the model doubts, with the answer read back, and
+    ``others``' readings under it (formula, probability), as
+    :func:`~ara.eval.consistency.readings` gives them after the winner."""
+    lines = [f"note: the model gives this answer a probability of {probability:.2g}; below "
+             f"{DOUBT:g}, about half of its answers on held-out sentences were wrong. It "
+             f"reads: \"{explain(parse(stl))}\". If that is not what you meant, reword the "
+             "sentence" + (", or take one of the other readings it weighed:" if others
+                           else ".")]
+    lines += [f"  {other}  (probability {p:.2g}): \"{explain(parse(other))}\""
+              for other, p in others]
+    return "\n".join(lines)

@@ -79,6 +79,26 @@ class Vote:
         return len(self.groups[0]) / len(self.answers)
 
 
+def readings(vote: Vote, timeout_s: float = 10.0,
+             limit: int | None = None) -> list[tuple[str, float]]:
+    """The distinct meanings among a vote's scored answers, best-scored first: each as
+    the text the model scored highest among those of that meaning, with that
+    log-probability. The winner comes first where it was scored; answers equivalent
+    by Spot are one reading (a check Spot cannot decide in ``timeout_s`` keeps both).
+    With a ``limit``, the first ``limit`` readings only, which spares the Spot checks
+    of the rest (seconds each on long formulas with large bounds).
+    """
+    kept: list[tuple[str, float]] = []
+    for group in vote.groups:
+        score = vote.scores[group[0]] if vote.scores else None
+        if score is None or (limit is not None and len(kept) >= limit):
+            continue
+        stl = vote.results[group[0]].stl
+        if not any(_same(stl, other, timeout_s) for other, _ in kept):
+            kept.append((stl, score))
+    return kept
+
+
 def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
                          shots: Sequence[Shot] = (), samples: int = 5,
                          temperature: float = 0.7, seed: int = 0,

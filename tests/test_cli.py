@@ -212,3 +212,24 @@ def test_translate_notes_an_answer_the_model_doubts():
     assert json.loads(ara("translate", *args, "--json").stdout)["confidence"] < 0.5
     out = ara("translate", "at no time (prop_1)", "--aps", "prop_1", "--json")
     assert json.loads(out.stdout)["confidence"] > 0.9 and "note" not in out.stderr
+    assert json.loads(out.stdout)["alternatives"] == []
+
+
+@needs_llama
+def test_a_doubted_answer_comes_with_the_other_readings_the_model_weighed():
+    """Tests --alternatives on a sentence whose scope the model hesitates over: each
+    other reading means something else than the answer, the model gives it no more
+    than the answer, and the note prints it with its English reading."""
+    from ara.grammars import parse
+    from ara.grammars.spot_bridge import equivalent
+
+    args = ["( prop_1 ) or ( prop_2 ) at some point", "--aps", "prop_1,prop_2"]
+    data = json.loads(ara("translate", *args, "--json").stdout)
+    assert data["confidence"] < 0.5 and 1 <= len(data["alternatives"]) <= 2
+    for other in data["alternatives"]:
+        assert other["probability"] <= data["confidence"]
+        assert not equivalent(parse(other["stl"]), parse(data["stl"]), timeout_s=10)
+    note = ara("translate", *args).stderr
+    assert "or take one of the other readings it weighed:" in note
+    assert f"  {data['alternatives'][0]['stl']}  (probability" in note
+    assert "other readings" not in ara("translate", *args, "--alternatives", "0").stderr

@@ -49,6 +49,10 @@ def test_the_note_reads_the_answer_back():
     note = doubt_warning("F(a & F(b))", 0.0123)
     assert note.startswith("note: the model gives this answer a probability of 0.012;")
     assert f"below {DOUBT:g}" in note and 'It reads: "first a, then b".' in note
+    with_others = doubt_warning("F(a & F(b))", 0.4, [("F(a) & F(b)", 0.35)])
+    assert "or take one of the other readings it weighed:" in with_others
+    assert with_others.splitlines()[1] == (
+        '  F(a) & F(b)  (probability 0.35): "eventually a, and eventually b"')
 
 
 def test_decoding_scores_its_answer_on_the_way(translator):

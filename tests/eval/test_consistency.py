@@ -9,14 +9,16 @@ import pytest
 from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
 from ara.eval.consistency import (
+    Vote,
     _group,
     literal_mends,
     rank_repairs,
+    readings,
     translate_consistent,
     translate_repaired,
 )
 from ara.eval.coverage import gaps
-from ara.eval.translator import Translator, TranslatorConfig
+from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
 
 from conftest import needs_llama
@@ -26,6 +28,27 @@ def test_answers_group_by_meaning_not_by_text():
     """Tests that Spot-equivalent spellings share a group and unparsed answers stand alone."""
     answers = ("F(a) | F(b)", "G(a)", "F(a | b)", None, "G(a)")
     assert _group(answers, timeout_s=10) == [(0, 2), (1, 4), (3,)]
+
+
+def _answer(stl: str) -> TranslationResult:
+    return TranslationResult(
+        nl="a or b at some point", aps=("a", "b"), raw=" " + stl, stl=stl, valid=True,
+        error=None, constrained=True, grammar_in_prompt=False, shots=0, prompt_sha256="",
+        prompt_tokens=0, completion_tokens=0, cached_tokens=0, ms=0.0, stop="eos",
+        masked_steps=0)
+
+
+def test_readings_are_the_distinct_meanings_best_scored_first():
+    """Tests the readings `ara translate --alternatives` lists: one per meaning, as its
+    best-scored spelling, in the vote's order; answers repair did not score (they leave
+    out more) are not readings."""
+    texts = ("F(a | b)", "F(a) | F(b)", "G(a)", "F(a) | b", "G(a)")
+    scores = (-0.9, -0.5, -1.2, None, -1.2)
+    vote = Vote(tuple(map(_answer, texts)), ((1,), (0,), (2, 4), (3,)), 0.0, scores)
+    assert readings(vote, timeout_s=10) == [("F(a) | F(b)", -0.5), ("G(a)", -1.2)]
+    assert readings(vote, timeout_s=10, limit=1) == [("F(a) | F(b)", -0.5)]
+    greedy_only = Vote((_answer("G(a)"),), ((0,),), 0.0)  # nothing scored
+    assert readings(greedy_only) == []
 
 
 def test_sampling_settings_are_checked():
