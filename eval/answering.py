@@ -9,6 +9,7 @@ doubts, and what the answer leaves out of the request. Each answer is a plain di
 from __future__ import annotations
 
 import math
+import random
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -23,7 +24,7 @@ from ara.eval.consistency import (
     translate_repaired,
 )
 from ara.eval.coverage import gaps
-from ara.eval.prompt import Shot
+from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import Translator
 from ara.grammars import parse
 
@@ -149,6 +150,22 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         gap = gaps(nl, aps, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
     return data
+
+
+def worked_examples(model: str, shots: int | None, aps: Sequence[str],
+                    seed: int = 0) -> list[Shot]:
+    """The worked examples a prompt for ``aps`` shows: ``shots`` of them (``None``: the
+    model's default, none for the fine-tuned adapters) from the compositional train
+    side, of the propositions' form (lifted or grounded), picked by ``seed``."""
+    from ara.data import load_or_prepare  # prepares the split on first use
+    from ara.data.normalize import form_of
+    from ara.eval.models import default_shots
+
+    k = shots if shots is not None else default_shots(model)
+    if not k:
+        return []
+    pool = load_or_prepare("compositional").records("train", form_of(tuple(aps)))
+    return sample_shots(pool, k, random.Random(seed))
 
 
 def doubted(data: dict) -> bool:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import random
 import signal
 from pathlib import Path
 
@@ -71,21 +70,6 @@ ALTERNATIVES = typer.Option(
 SERVER = typer.Option("openai", "--server", help=SERVER_HELP)
 
 
-def worked_examples(model: str, shots: int | None, aps: tuple[str, ...], seed: int) -> list:
-    """The worked examples a prompt for ``aps`` shows: ``shots`` of them (``None``: the
-    model's default) from the compositional train side, of the propositions' form."""
-    from ara.data import load_or_prepare
-    from ara.data.normalize import form_of
-    from ara.eval.models import default_shots
-    from ara.eval.prompt import sample_shots
-
-    k = shots if shots is not None else default_shots(model)
-    if not k:
-        return []
-    pool = load_or_prepare("compositional").records("train", form_of(aps))
-    return sample_shots(pool, k, random.Random(seed))
-
-
 def translate_cmd(
     nl: str = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'."),
     aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, each "
@@ -120,7 +104,7 @@ def translate_cmd(
     half of such held-out answers were wrong), with the other readings it
     weighed. --json has them as "confidence" and "alternatives".
     """
-    from ara.eval.answering import AnswerConfig, answer, doubted
+    from ara.eval.answering import AnswerConfig, answer, doubted, worked_examples
     from ara.eval.confidence import doubt_warning
     from ara.eval.coverage import Gaps
     from ara.eval.models import make_backend
@@ -185,7 +169,8 @@ def translate_file_cmd(
     """
     from tqdm import tqdm
 
-    from ara.eval.answering import AnswerConfig
+    from ara.data.normalize import form_of
+    from ara.eval.answering import AnswerConfig, worked_examples
     from ara.eval.batch import (
         done_lines,
         read_requests,
@@ -207,12 +192,14 @@ def translate_file_cmd(
                               "another --out")
         translator = Translator(make_backend(model, server=server), config)
         done = done_lines(out, todo, translator.backend.model_id)
-        examples: dict[tuple[str, ...], list] = {}
+        examples: dict[str, list] = {}
 
         def shots_for(aps: tuple[str, ...]) -> list:
-            if aps not in examples:
-                examples[aps] = worked_examples(model, shots, aps, seed)
-            return examples[aps]
+            # The same examples for every request of a form, as ara translate would pick.
+            form = form_of(aps)
+            if form not in examples:
+                examples[form] = worked_examples(model, shots, aps, seed)
+            return examples[form]
 
         if done:
             typer.echo(f"resuming {out} after {done} of {len(todo)} answers", err=True)
