@@ -1,7 +1,7 @@
 """How often helpers read a help request right: every wording of the pallet request
 (the paper's and ten rewordings) at several sites, translated by one model with the
-protocol's worked examples, each formula judged by Spot against the template's
-pick-before-place spec.
+protocol's worked examples and repaired as a helper repairs it (as `ara translate`
+does), each formula judged by Spot against the template's pick-before-place spec.
 
     .venv/bin/python bench/help_request_wordings.py [--model finetuned] [--sites 5]
         [--out docs/results/help-request-wordings.json]
@@ -26,6 +26,7 @@ from ara.coordination.protocol import (
     template_help_spec,
 )
 from ara.coordination.world import GridWorld
+from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator
 from ara.grammars import parse
@@ -50,14 +51,17 @@ def main() -> None:
     for wording, site in tqdm(jobs, desc="requests", unit="request"):
         drop = world.nearest_free_neighbour(site)
         text = request_text(site, CAPS, wording=wording)
-        result = translator.translate(text, help_props(site, drop), request_shots())
+        vote = translate_repaired(translator, text, help_props(site, drop), request_shots(),
+                                  samples=DEFAULT_REPAIR)  # as a helper reads it
+        result = vote.result
         try:
             same = equivalent(parse(result.stl), template_help_spec(site, drop, ()),
                               timeout_s=30)
         except SpotTimeoutError:
             same = None
         rows.append({"wording": wording, "site": list(site), "stl": result.stl,
-                     "equivalent": same, "ms": round(result.ms, 1)})
+                     "equivalent": same, "ms": round(vote.ms, 1),
+                     "answers_weighed": len(vote.results)})
     print("| wording | equivalent to the template | of |\n|---:|---:|---:|")
     for w in range(len(REQUEST_WORDINGS)):
         mine = [r for r in rows if r["wording"] == w]

@@ -63,6 +63,7 @@ from ara.coordination.protocol import (
     template_help_spec,
 )
 from ara.coordination.trials import PAPER_WORLD, Trial, closest_robot, make_trial
+from ara.eval.translator import Translator
 
 #: The run folder's row log: one JSON line per (trial, method).
 TRIALS = "trials.jsonl"
@@ -194,22 +195,28 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     return summary
 
 
-class SharedTranslator:
+class SharedTranslator(Translator):
     """One translator for all simulated helpers of a process.
 
-    Every helper runs the same model and grammar with greedy decoding, so they would
-    all get the same formula for the same request; computing it once per request
-    changes no result, only the run time (6x fewer generations).
+    Every helper runs the same model and grammar and repairs the same way (seeded
+    samples), so they would all get the same formulas for the same request; keeping
+    the current request's generations changes no result, only the run time (6x fewer
+    generations).
     """
 
-    def __init__(self, translator) -> None:
-        self.translator, self.backend, self._memo = translator, translator.backend, {}
+    def __init__(self, translator: Translator) -> None:
+        super().__init__(translator.backend, translator.config)
+        self._memo: dict = {}
 
-    def translate(self, nl, aps, shots=(), grammar_in_prompt=False, constrained=True):
-        key = (nl, tuple(aps), tuple(shots), grammar_in_prompt, constrained)
-        if key not in self._memo:  # one request at a time: keep only the latest
-            self._memo = {key: self.translator.translate(nl, aps, shots, grammar_in_prompt,
-                                                         constrained)}
+    def translate(self, nl, aps, shots=(), grammar_in_prompt=False, constrained=True,
+                  sampling=None, require=()):
+        key = (nl, tuple(aps), tuple(shots), grammar_in_prompt, constrained, sampling,
+               tuple(require))
+        if any(k[:2] != key[:2] for k in self._memo):  # one request at a time
+            self._memo = {}
+        if key not in self._memo:
+            self._memo[key] = super().translate(nl, aps, shots, grammar_in_prompt,
+                                                constrained, sampling, require)
         return self._memo[key]
 
 

@@ -256,7 +256,8 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
                help_formula: Formula | None = None) -> Offer:
     """A helper reads the request, writes its STL, plans, and bids.
 
-    With a ``translator`` the help formula is the translator's (logged in the offer,
+    With a ``translator`` (a :class:`~ara.eval.translator.Translator`) the help formula
+    is its translation, repaired as ``ara translate`` repairs it (logged in the offer,
     right or wrong, and planned as it says); with ``help_formula`` it is that formula
     (over :func:`help_props`); otherwise it is the template spec. The DP planner
     handles the template spec only. ``shots`` default to :func:`request_shots`.
@@ -288,8 +289,14 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     others = sorted(own_vocab.events)
     template = template_help_spec(site, drop, others)
     if translator is not None:
+        from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
+
         shots = request_shots() if shots is None else shots
-        result = translator.translate(request.text, (pick, place), shots, constrained=True)
+        # Repaired as `ara translate` repairs, so a helper reads a request as a user's
+        # own translation would: the greedy answer unless it leaves part out or the
+        # model doubts it.
+        result = translate_repaired(translator, request.text, (pick, place), shots,
+                                    samples=DEFAULT_REPAIR).result
         if not result.valid:
             return _decline(helper, f"could not translate the request ({result.error})")
         help_formula = parse(result.stl)

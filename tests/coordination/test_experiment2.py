@@ -173,3 +173,26 @@ def test_the_translation_summary_counts_wrong_formulas_and_their_cost():
     assert seen["delta_change_when_changed"] == [2, None]
     assert seen["by_wording"] == {"0": {"equivalent": 1, "trials": 1},
                                   "1": {"equivalent": 0, "trials": 2}}
+
+
+def test_helpers_share_one_translation_of_a_request(llama_backend):
+    """Tests the translator Experiment 2's helpers share: a repeated generation of the
+    current request (greedy or seeded sample) is given again, not recomputed; a new
+    request starts afresh; and repair, which helpers run as `ara translate` does, takes
+    it as any translator."""
+    from ara.coordination.experiment2 import SharedTranslator
+    from ara.eval.backends.base import Sampling
+    from ara.eval.consistency import translate_repaired
+    from ara.eval.translator import Translator
+
+    shared = SharedTranslator(Translator(llama_backend))
+    nl, aps = "always avoid ( prop_1 )", ("prop_1",)
+    first = shared.translate(nl, aps)
+    assert shared.translate(nl, aps) is first
+    drawn = shared.translate(nl, aps, sampling=Sampling(temperature=0.7, seed=1))
+    assert shared.translate(nl, aps, sampling=Sampling(temperature=0.7, seed=1)) is drawn
+    other = shared.translate("eventually ( prop_1 )", aps)
+    assert other is not first and shared.translate(nl, aps) is not first  # forgotten
+    vote = translate_repaired(shared, nl, aps, samples=2)
+    assert vote.results[0] is shared.translate(nl, aps)  # repair's greedy call, kept
+    assert len(vote.results) in (1, 3)  # the greedy answer, or it and 2 samples
