@@ -122,17 +122,12 @@ def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
     if translator is None:
         stl, source = errand.reference, "reference"
     else:
-        from ara.eval.confidence import DOUBT, doubt_warning, winner_probability
-        from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
-        from ara.eval.coverage import gaps
+        from ara.eval.answering import answer, notes
 
-        # Repaired and checked as `ara translate` does, so the demo shows what a user gets
-        vote = translate_repaired(translator, errand.nl, aps, samples=DEFAULT_REPAIR)
-        stl, source = vote.result.stl, f"translated by {translator.backend.model_id}"
-        warnings = [gap.warning()] if (gap := gaps(errand.nl, aps, parse(stl))) else []
-        probability = winner_probability(translator, vote)
-        if probability is not None and probability < DOUBT:
-            warnings.append(doubt_warning(stl, probability))
+        # Answered and checked as `ara translate` does, so the demo shows what a user gets
+        data = answer(translator, errand.nl, aps)
+        stl, source = data["stl"], f"translated by {translator.backend.model_id}"
+        warnings, probability = notes(data), data["confidence"]
     echo(f"[STL, {source}] {stl}")
     for warning in warnings:
         echo(warning)

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ara.errors import ConfigError
-from ara.eval.confidence import DOUBT, result_probability, winner_probability
+from ara.eval.confidence import DOUBT, doubt_warning, result_probability, winner_probability
 from ara.eval.consistency import (
     DEFAULT_REPAIR,
     REPAIR_BY,
@@ -23,7 +23,7 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
-from ara.eval.coverage import gaps
+from ara.eval.coverage import Gaps, gaps
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.translator import Translator
 from ara.grammars import parse
@@ -138,18 +138,23 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
     probability = (winner_probability(translator, vote, shots, config.grammar_in_prompt)
                    if vote else result_probability(translator, result, shots,
                                                    config.grammar_in_prompt))
-    data["confidence"] = None if probability is None else round(probability, 3)
+    data["confidence"] = None if probability is None else _significant(probability)
     others: list[tuple[str, float]] = []
     if doubted(data) and vote is not None:
         # The winner is scored whenever anything is, so the first reading is its.
         others = [(stl, math.exp(score))
                   for stl, score in readings(vote, SAME_READING_TIMEOUT_S,
                                              limit=1 + config.alternatives)[1:]]
-    data["alternatives"] = [{"stl": stl, "probability": round(p, 3)} for stl, p in others]
+    data["alternatives"] = [{"stl": stl, "probability": _significant(p)} for stl, p in others]
     if result.stl is not None:
         gap = gaps(nl, aps, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
     return data
+
+
+def _significant(p: float) -> float:
+    """``p`` to 3 significant digits: a reading the model gives 0.0004 is not 0."""
+    return float(f"{p:.3g}")
 
 
 def worked_examples(model: str, shots: int | None, aps: Sequence[str],
@@ -166,6 +171,22 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str],
         return []
     pool = load_or_prepare("compositional").records("train", form_of(tuple(aps)))
     return sample_shots(pool, k, random.Random(seed))
+
+
+def notes(data: dict) -> list[str]:
+    """What to tell a user about an answer (:func:`answer`'s dict), as ``ara translate``
+    prints it on stderr: what it leaves out of the request, and, if the model doubts
+    it, the answer read back with the other readings it weighed."""
+    if data["stl"] is None:
+        return []
+    said = []
+    gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]))
+    if gap:
+        said.append(gap.warning())
+    if doubted(data):
+        others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
+        said.append(doubt_warning(data["stl"], data["confidence"], others))
+    return said
 
 
 def doubted(data: dict) -> bool:

@@ -104,9 +104,7 @@ def translate_cmd(
     half of such held-out answers were wrong), with the other readings it
     weighed. --json has them as "confidence" and "alternatives".
     """
-    from ara.eval.answering import AnswerConfig, answer, doubted, worked_examples
-    from ara.eval.confidence import doubt_warning
-    from ara.eval.coverage import Gaps
+    from ara.eval.answering import AnswerConfig, answer, notes, worked_examples
     from ara.eval.models import make_backend
     from ara.eval.translator import Translator, TranslatorConfig, check_request
 
@@ -122,13 +120,8 @@ def translate_cmd(
         examples = worked_examples(model, shots, names, seed)
         translator = Translator(make_backend(model, server=server), config)
         data = answer(translator, nl, names, examples, how)
-    if not as_json and "left_out" in data:
-        gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]))
-        if gap:
-            typer.echo(gap.warning(), err=True)
-        if doubted(data):
-            others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
-            typer.echo(doubt_warning(data["stl"], data["confidence"], others), err=True)
+    for note in [] if as_json else notes(data):  # JSON users read the fields
+        typer.echo(note, err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
 
 
