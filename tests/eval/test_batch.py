@@ -35,6 +35,13 @@ def test_requests_are_read_with_their_line_numbers_and_references(tmp_path):
                     "F(prop_1 & F(prop_2))", "7")]
 
 
+def test_the_example_file_in_the_docs_reads():
+    """Tests docs/examples/requests.jsonl, the file the README points users to."""
+    path = Path(__file__).parents[2] / "docs" / "examples" / "requests.jsonl"
+    requests = read_requests(path, TranslatorConfig())
+    assert len(requests) == 8 and sum(r.reference is not None for r in requests) == 7
+
+
 def test_every_bad_line_is_named_before_anything_is_translated(tmp_path):
     """Tests that one error lists each bad line with its number and what is wrong."""
     path = _write(tmp_path / "in.jsonl",
