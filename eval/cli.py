@@ -180,6 +180,8 @@ def translate_file_cmd(
         todo = read_requests(requests, config)
         how = AnswerConfig(repair=repair, repair_by=repair_by, doubt=doubt,
                            temperature=temperature, seed=seed, alternatives=alternatives)
+        if out.is_dir():
+            raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
         if out.exists() and out.stat().st_size and not resume:
             raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
                               "another --out")

@@ -126,6 +126,9 @@ def test_translate_file_answers_every_line_and_resumes_after_an_interruption(tmp
 
     refused = subprocess.run(args, capture_output=True, text=True, timeout=600)
     assert refused.returncode == 2 and "exists: pass --resume" in refused.stderr
+    folder = subprocess.run([*args[:-3], "--out", str(tmp_path)], capture_output=True, text=True,
+                            timeout=600)
+    assert folder.returncode == 2 and "is a folder: name the JSON Lines file" in folder.stderr
     out.write_text(out.read_text().splitlines(keepends=True)[0] + '{"line": 2, "n')
     resumed = subprocess.run([*args, "--resume"], capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
