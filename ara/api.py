@@ -55,8 +55,10 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
     config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
                               bounds_from_request=not any_bound)
     check_request(nl, aps, config)
-    return answer(translator(model, config, server), nl, aps,
-                  worked_examples(model, shots, aps, seed), AnswerConfig(seed=seed, **how))
+    # Options and worked examples first: a mistake there is refused before the model loads.
+    how = AnswerConfig(seed=seed, **how)
+    examples = worked_examples(model, shots, aps, seed)
+    return answer(translator(model, config, server), nl, aps, examples, how)
 
 
 @lru_cache(maxsize=4)

@@ -104,22 +104,16 @@ def translate_cmd(
     half of such held-out answers were wrong), with the other readings it
     weighed. --json has them as "confidence" and "alternatives".
     """
-    from ara.eval.answering import AnswerConfig, answer, notes, worked_examples
-    from ara.eval.models import make_backend
-    from ara.eval.translator import Translator, TranslatorConfig, check_request
+    from ara.api import translate
+    from ara.eval.answering import notes
 
-    with user_errors():
-        names = split_list(aps)
-        config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
-                                  bounds_from_request=not any_bound)
-        check_request(nl, names, config)
-        how = AnswerConfig(samples=samples, repair=repair, repair_by=repair_by, doubt=doubt,
-                           temperature=temperature, seed=seed,
-                           grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
-                           alternatives=alternatives)
-        examples = worked_examples(model, shots, names, seed)
-        translator = Translator(make_backend(model, server=server), config)
-        data = answer(translator, nl, names, examples, how)
+    with user_errors():  # the same path as ara.translate from Python
+        data = translate(nl, split_list(aps), model, shots=shots, seed=seed,
+                         intervals=intervals, max_bound=max_bound, any_bound=any_bound,
+                         server=server, samples=samples, repair=repair, repair_by=repair_by,
+                         doubt=doubt, temperature=temperature,
+                         grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
+                         alternatives=alternatives)
     for note in [] if as_json else notes(data):  # JSON users read the fields
         typer.echo(note, err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")

@@ -50,15 +50,25 @@ def answer_probability(translator: Translator, nl: str, aps: Sequence[str], stl:
     return math.exp(translator.score(nl, aps, [parse(stl)], shots, grammar_in_prompt)[0])
 
 
+def result_score(translator: Translator, result: TranslationResult,
+                 shots: Sequence[Shot] = (), grammar_in_prompt: bool = False) -> float | None:
+    """The model's log-probability of a translation's answer: the one decoding summed on
+    the way where it has one (no second pass), else a scoring pass; ``None`` where there
+    is no answer or the backend cannot score."""
+    if result.logprob is not None:
+        return result.logprob
+    if result.stl is None or not translator.can_score:
+        return None
+    return translator.score(result.nl, result.aps, [parse(result.stl)], shots,
+                            grammar_in_prompt)[0]
+
+
 def result_probability(translator: Translator, result: TranslationResult,
                        shots: Sequence[Shot] = (),
                        grammar_in_prompt: bool = False) -> float | None:
-    """:func:`answer_probability` of a translation's answer, from the log-probability
-    decoding summed on the way where it has one (no second pass)."""
-    if result.logprob is not None:
-        return math.exp(result.logprob)
-    return answer_probability(translator, result.nl, result.aps, result.stl, shots,
-                              grammar_in_prompt)
+    """:func:`answer_probability` of a translation's answer, from :func:`result_score`."""
+    score = result_score(translator, result, shots, grammar_in_prompt)
+    return None if score is None else math.exp(score)
 
 
 def winner_probability(translator: Translator, vote: Vote, shots: Sequence[Shot] = (),

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
-from ara.eval.confidence import DOUBT
+from ara.eval.confidence import DOUBT, result_score
 from ara.eval.coverage import gaps
 from ara.eval.prompt import Shot
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
@@ -90,8 +90,10 @@ def readings(vote: Vote, timeout_s: float = 10.0,
     """
     kept: list[tuple[str, float]] = []
     for group in vote.groups:
+        if limit is not None and len(kept) >= limit:
+            break
         score = vote.scores[group[0]] if vote.scores else None
-        if score is None or (limit is not None and len(kept) >= limit):
+        if score is None:
             continue
         stl = vote.results[group[0]].stl
         if not any(_same(stl, other, timeout_s) for other, _ in kept):
@@ -204,8 +206,7 @@ def _unless_doubted(translator: Translator, greedy: TranslationResult, shots: Se
     nl, aps = greedy.nl, greedy.aps
     if not doubt or not translator.can_score:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
-    score = (greedy.logprob if greedy.logprob is not None else  # decoding's own, free
-             translator.score(nl, aps, [parse(greedy.stl)], shots, grammar_in_prompt)[0])
+    score = result_score(translator, greedy, shots, grammar_in_prompt)  # decoding's, if any
     if math.exp(score) >= doubt:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
