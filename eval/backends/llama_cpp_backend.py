@@ -9,6 +9,16 @@ longest common token prefix with the previous prompt keeps its KV cache, so a ru
 shares its few-shot examples evaluates them once. The cache is full-size
 (``swa_full``), because Gemma 3's sliding-window cache cannot roll back to an earlier
 position once it has slid past it.
+
+An answer must not depend on what was asked before it. llama.cpp's CPU kernels give a
+position's scores a little differently depending on where it falls in the batch that
+computed it (a quantized matrix product takes rows four at a time and the leftover
+ones another way): on the embedded model, up to 0.9 in a logit, enough to change a
+sampled answer or the ranking of two close ones. So prompts are fed in chunks that
+start at fixed positions (multiples of :data:`CHUNK`), only whole chunks are reused,
+and asking the same prompt again (the samples of one request) reuses its scores
+rather than re-feeding its last token: every position is computed the way a fresh
+model computes it, whatever came before.
 """
 
 from __future__ import annotations
@@ -28,6 +38,10 @@ from ara.grammars import BuiltGrammar
 from ara.provenance import sha256_file
 
 MASK_ENGINES = ("llguidance", "llama")
+
+#: Prompt positions are fed in chunks starting at multiples of this; whole chunks are
+#: the unit of reuse. Larger reuses less of a shared prefix, smaller feeds more batches.
+CHUNK = 64
 
 
 class LlamaCppBackend:
@@ -71,6 +85,11 @@ class LlamaCppBackend:
         self._vocab = llama_cpp.llama_model_get_vocab(self.llm._model.model)
         self._eos = {self.llm.token_eos(), *self._end_of_turn()}
         self._lltokenizer = None
+        # The last prompt fed, its scores, and how many of its leading positions the
+        # cache still holds as that feed computed them (scoring may overwrite the last).
+        self._prompt: list[int] = []
+        self._prompt_logits: np.ndarray | None = None
+        self._intact = 0
 
     def _end_of_turn(self) -> list[int]:
         ids = self.llm.tokenize(b"<end_of_turn>", add_bos=False, special=True)
@@ -93,15 +112,24 @@ class LlamaCppBackend:
     def _logits(self) -> np.ndarray:
         return np.ctypeslib.as_array(self.llm._ctx.get_logits(), shape=(self.llm.n_vocab(),))
 
-    def _feed_prompt(self, tokens: list[int]) -> int:
-        """Evaluate the prompt, reusing the cached prefix; returns the reused length."""
-        cached = self.llm.input_ids[: self.llm.n_tokens]
+    def _feed_prompt(self, tokens: list[int]) -> tuple[np.ndarray, int]:
+        """Evaluate the prompt as a fresh model would, reusing what the cache holds of it
+        (module docstring); returns the scores after its last token (a copy) and how
+        many positions were reused."""
+        if tokens == self._prompt and self._intact == len(tokens):
+            self.llm.n_tokens = len(tokens)  # generated positions are dropped on next eval
+            return self._prompt_logits.copy(), len(tokens)
+        cached = self._prompt[: self._intact]
         limit = min(len(cached), len(tokens) - 1)  # evaluate >= 1 token to get logits
-        same = np.flatnonzero(cached[:limit] != np.asarray(tokens[:limit]))
-        reused = int(same[0]) if same.size else limit
+        same = np.flatnonzero(np.asarray(cached[:limit]) != np.asarray(tokens[:limit]))
+        shared = int(same[0]) if same.size else limit
+        reused = min(shared, self._intact // CHUNK * CHUNK) // CHUNK * CHUNK
         self.llm.n_tokens = reused
-        self.llm.eval(tokens[reused:])
-        return reused
+        for begin in range(reused, len(tokens), CHUNK):
+            self.llm.eval(tokens[begin: begin + CHUNK])
+        self._prompt, self._intact = list(tokens), len(tokens)
+        self._prompt_logits = self._logits().copy()
+        return self._prompt_logits.copy(), reused
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
                  stop: str, sampling: Sampling | None = None) -> Completion:
@@ -114,7 +142,7 @@ class LlamaCppBackend:
                 f"prompt of {len(tokens)} tokens + {max_tokens} to generate exceeds the "
                 f"context of {self.llm.n_ctx()}; pass a larger n_ctx or fewer shots"
             )
-        reused = self._feed_prompt(tokens)
+        first, reused = self._feed_prompt(tokens)
         if grammar is not None and self.mask == "llama":
             if sampling is not None:
                 raise BackendError("sampling runs with the llguidance mask; pass mask='llguidance'")
@@ -126,7 +154,7 @@ class LlamaCppBackend:
             return self._logits()
 
         text, out, reason, logprob = greedy_decode(
-            self._logits(), advance,
+            first, advance,
             lambda ids: self.llm.detokenize(ids).decode("utf-8", errors="replace"),
             matcher, self._eos, max_tokens, stop, Sampler(sampling) if sampling else None)
         return Completion(text, len(tokens), len(out), reused,
@@ -141,7 +169,8 @@ class LlamaCppBackend:
 
     def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
         """Log-probability of each continuation after ``prompt``, teacher-forced without a
-        grammar (see :func:`~ara.eval.backends.masking.score_paths`)."""
+        grammar (see :func:`~ara.eval.backends.masking.score_paths`); each the same
+        whatever else is scored with it."""
         tokens = self.llm.tokenize(prompt.encode(), add_bos=True, special=False)
         paths = [self.llm.tokenize(c.encode(), add_bos=False, special=False)
                  for c in continuations]
@@ -150,8 +179,18 @@ class LlamaCppBackend:
             raise BackendError(f"prompt of {len(tokens)} tokens + {longest} to score exceeds "
                                f"the context of {self.llm.n_ctx()} or a batch of "
                                f"{self.llm.n_batch}")
-        self._feed_prompt(tokens)
-        return score_paths(tokens, paths, self._rows)
+        first, _ = self._feed_prompt(tokens)
+
+        def rows(start: int, fed: list[int]) -> np.ndarray:
+            if start == len(tokens) - 1:  # the prompt's last position: its scores, kept
+                head = first[None, :]
+                return head if len(fed) == 1 else np.vstack([head, self._rows(start + 1,
+                                                                               fed[1:])])
+            return self._rows(start, fed)
+
+        # One path at a time, each fed from the prompt's end: sharing a prefix with the
+        # path before it would make a path's score depend on what else is scored.
+        return [score_paths(tokens, [path], rows)[0] for path in paths]
 
     def _rows(self, start: int, tokens: list[int]) -> np.ndarray:
         """Scores after each of ``tokens``, fed at position ``start`` in one batch.
@@ -161,6 +200,7 @@ class LlamaCppBackend:
         gigabytes here), so this asks llama.cpp for every row of this one batch only.
         """
         llm = self.llm
+        self._intact = min(self._intact, start)
         llm.n_tokens = start
         llm._ctx.kv_cache_seq_rm(-1, start, -1)
         llm._batch.set_batch(batch=tokens, n_past=start, logits_all=True)
@@ -176,6 +216,7 @@ class LlamaCppBackend:
         path): llama.cpp checks every vocabulary entry against the GBNF at each step."""
         gbnf = self._lc.LlamaGrammar.from_string(grammar.grammar.to_gbnf(), verbose=False)
         prompt_tokens = self.llm.input_ids[: self.llm.n_tokens].tolist()
+        self._intact = min(self._intact, n_prompt - 1)  # llama-cpp-python re-feeds the last
         result = self.llm.create_completion(prompt_tokens, max_tokens=max_tokens, temperature=0.0,
                                             grammar=gbnf)
         choice = result["choices"][0]

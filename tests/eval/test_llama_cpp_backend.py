@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.backends.base import BackendError
+from ara.eval.backends.base import BackendError, Sampling
 from ara.eval.backends.masking import allowed_tokens
 from ara.eval.prompt import STOP, build_prompt, sample_shots
 from ara.eval.translator import Translator, TranslatorConfig
@@ -89,18 +89,30 @@ def test_an_answer_can_be_required_to_write_what_the_request_lists(llama_backend
 
 def test_prefix_reuse_changes_nothing_but_the_work(llama_backend, embedded_model_path,
                                                    paper_split):
-    """Tests that a prompt sharing its prefix with the previous one gives the same
-    answer as a fresh model would, while evaluating fewer prompt tokens."""
+    """Tests that a prompt sharing its prefix with the previous one gets exactly what a
+    fresh model gives it (text, log-probability, seeded samples, scores), while
+    evaluating fewer prompt tokens: an answer does not depend on what came before."""
     from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
 
     shots = sample_shots(paper_split.records("train", "lifted"), 5, random.Random(1))
     tests = paper_split.records("test", "lifted")[:3]
     prompts = [build_prompt(r.nl, r.aps, shots) for r in tests]
-    warm = [llama_backend.complete(p, None, 32, STOP) for p in prompts]
-    assert warm[1].cached_tokens > 0.8 * warm[1].prompt_tokens
-    for prompt, reused in zip(prompts, warm, strict=True):
-        fresh = LlamaCppBackend(embedded_model_path, n_ctx=4096).complete(prompt, None, 32, STOP)
-        assert fresh.cached_tokens == 0 and fresh.text == reused.text
+    grammars = [decoding_grammar(r.aps) for r in tests]
+
+    def answers(backend, prompt, grammar):
+        greedy = backend.complete(prompt, grammar, 32, STOP)
+        drawn = [backend.complete(prompt, grammar, 32, STOP, Sampling(1.0, seed=k))
+                 for k in range(2)]
+        scores = backend.score(prompt, [greedy.text + STOP, " G(prop_1)" + STOP])
+        return greedy, [(c.text, c.logprob) for c in drawn], scores
+
+    warm = [answers(llama_backend, *pg) for pg in zip(prompts, grammars, strict=True)]
+    assert warm[1][0].cached_tokens > 0.8 * warm[1][0].prompt_tokens
+    for prompt, grammar, (greedy, drawn, scores) in zip(prompts, grammars, warm, strict=True):
+        fresh = answers(LlamaCppBackend(embedded_model_path, n_ctx=4096), prompt, grammar)
+        assert fresh[0].cached_tokens == 0
+        assert (fresh[0].text, fresh[0].logprob) == (greedy.text, greedy.logprob)
+        assert (fresh[1], fresh[2]) == (drawn, scores)
 
 
 def test_llguidance_and_llama_cpp_masks_choose_the_same_tokens(embedded_model_path,
@@ -129,13 +141,13 @@ ANSWERS = (" G(!door) & F(goal)\n", " F(goal) & G(!door)\n", " G(door)\n", " G(!
 
 
 def test_scores_do_not_depend_on_what_else_is_scored(llama_backend):
-    """Tests that answers scored together (sharing a prefix, fed in batches) get what
-    each gets alone, in any order: log-probabilities, so below zero."""
+    """Tests that answers scored together get exactly what each gets alone, in any
+    order: log-probabilities, so below zero."""
     prompt = build_prompt("always avoid the door and eventually reach the goal",
                           ("door", "goal"), ())
     together = llama_backend.score(prompt, ANSWERS)
     assert together == llama_backend.score(prompt, ANSWERS[::-1])[::-1]
     alone = [llama_backend.score(prompt, [a])[0] for a in ANSWERS]
-    assert together == pytest.approx(alone, abs=0.2)  # batch sizes round differently
+    assert together == alone
     assert all(x < 0 for x in together)
     assert llama_backend.score(prompt, []) == []

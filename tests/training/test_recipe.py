@@ -143,8 +143,7 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
     prompt = "NL: always (prop_1)\nPropositions: prop_1\nSTL:"
     tokens = llama.llm.tokenize(prompt.encode(), add_bos=True, special=False)
     assert tokens == hf.tokenizer(prompt, add_special_tokens=True)["input_ids"]
-    llama._feed_prompt(tokens)
-    ours = llama._logits().copy()
+    ours, _ = llama._feed_prompt(tokens)
     theirs, _ = hf._feed_prompt(tokens)
     assert np.corrcoef(ours, theirs)[0, 1] > 0.999
 
