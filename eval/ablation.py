@@ -10,14 +10,33 @@ from tqdm import tqdm
 from ara.data import load_or_prepare
 from ara.errors import ConfigError
 from ara.eval.backends.base import Backend
-from ara.eval.harness import AblationConfig, plan, run_metadata, sample_of, translate_job
+from ara.eval.harness import (
+    FILE_SPLIT,
+    AblationConfig,
+    Split,
+    plan,
+    run_metadata,
+    sample_of,
+    translate_job,
+)
 from ara.eval.report import Results, write_report
 from ara.eval.run_store import RunStore
 from ara.eval.translator import Translator
+from ara.eval.user_data import file_split
+
+
+def load_data(config: AblationConfig) -> Split:
+    """The run's data: a registered split (prepared on first use) or the user's files."""
+    if config.split == FILE_SPLIT:
+        assert config.data is not None  # the config insists
+        examples = None if config.examples is None else Path(config.examples)
+        return file_split(Path(config.data), examples, config.translator)
+    return load_or_prepare(config.split, config.data_seed)
 
 
 def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bool = False,
-                 progress: bool = True, concurrency: int = 1) -> Results:
+                 progress: bool = True, concurrency: int = 1,
+                 split: Split | None = None) -> Results:
     """Run (or continue) ``config`` with ``backend`` into ``out`` and write its report.
 
     Interrupting (Ctrl-C, SIGTERM via the CLI) keeps every finished sample; the
@@ -27,13 +46,16 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
     that many generations are in flight at once; samples are still judged and written
     one at a time in the planned order, so the log, resume and the no-duplicate rule
     are those of a serial run.
+
+    ``split`` is the run's data if the caller already read it (:func:`load_data`),
+    e.g. to refuse a bad file before loading the model.
     """
     if concurrency < 1:
         raise ConfigError(f"--concurrency must be >= 1, got {concurrency}")
     if concurrency > 1 and not getattr(backend, "concurrent", False):
         raise ConfigError("--concurrency > 1 needs a remote backend (--model http://...): a "
                           "local model generates one answer at a time")
-    split = load_or_prepare(config.split, config.data_seed)
+    split = load_data(config) if split is None else split
     meta = run_metadata(config, split, backend.model_id)
     translator = Translator(backend, config.translator)
     jobs = list(plan(config, split))

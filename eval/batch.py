@@ -25,7 +25,7 @@ from ara.eval.answering import AnswerConfig, answer, doubted
 from ara.eval.harness import judge
 from ara.eval.prompt import Shot
 from ara.eval.translator import Translator, TranslatorConfig, check_request
-from ara.grammars import parse, to_text
+from ara.grammars import atoms, parse, to_text
 
 #: Bad lines named in one error; the rest are counted.
 MAX_REPORTED = 10
@@ -104,7 +104,12 @@ def _request(number: int, text: str, config: TranslatorConfig) -> FileRequest:
     if reference is not None:
         if not isinstance(reference, str):
             raise ConfigError('"stl" must be a formula, a string')
-        reference = to_text(parse(reference))
+        formula = parse(reference)
+        foreign = sorted(atoms(formula) - set(aps))
+        if foreign:  # the grammar over aps could never write it
+            raise ConfigError(f'the reference names {", ".join(foreign)}, which "aps" does '
+                              "not list")
+        reference = to_text(formula)
     ident = row.get("id")
     return FileRequest(number, nl, tuple(aps), reference,
                        None if ident is None else str(ident))

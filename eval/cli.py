@@ -210,11 +210,24 @@ def translate_file_cmd(
 @eval_app.command("ablation")
 def ablation_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder: samples.jsonl, results.json, ..."),
-    split: str = typer.Option("paper", "--split",
-                              help="paper, disjoint, timed, compositional (held-out shapes "
-                                   "and phrasings), handwritten (the hand-written suite) "
-                                   "or handwritten2 (the second, never read for data)."),
-    form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
+    split: str | None = typer.Option(
+        None, "--split",
+        help="paper (the default), disjoint, timed, compositional (held-out shapes and "
+             "phrasings), handwritten (the hand-written suite) or handwritten2 (the "
+             "second, never read for data)."),
+    data: Path | None = typer.Option(
+        None, "--data", dir_okay=False,
+        help="Your own pairs instead of a split: JSON Lines as `ara translate-file` reads, "
+             'each line with its reference, e.g. {"nl": "never enter the lab", "aps": '
+             '["enter_lab"], "stl": "G(!enter_lab)"}.'),
+    examples: Path | None = typer.Option(
+        None, "--examples", dir_okay=False,
+        help="With --data: a file of pairs in the same format to draw worked examples "
+             "from (lines whose sentence is a test are left out). Default: the "
+             "compositional train side, in your lines' form."),
+    form: str | None = typer.Option(
+        None, "--form",
+        help="lifted or grounded (default: lifted; with --data, every line)."),
     variants: str = typer.Option("F,F+P,F+P+C", "--variants",
                                  help="Comma list of variants: letters F, P, C joined by "
                                       "+, or none (zero-shot, unconstrained)."),
@@ -250,24 +263,33 @@ def ablation_cmd(
              "model gives a probability below this (0: answers with a gap only)."),
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
-    from ara.eval.ablation import run_ablation
-    from ara.eval.harness import AblationConfig
+    from ara.eval.ablation import load_data, run_ablation
+    from ara.eval.harness import FILE_SPLIT, AblationConfig
     from ara.eval.models import make_backend
     from ara.eval.report import tables_markdown
 
     # SIGTERM ends the run like Ctrl-C: finished samples stay, the report is written.
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     with user_errors():
+        if data is not None and split is not None:
+            raise ConfigError("--split or --data: a run reads one split, or your own file")
+        if examples is not None and data is None:
+            raise ConfigError("--examples goes with --data; a split has its own train side")
         config = AblationConfig(
-            split=split, form=form, variants=split_list(variants),
+            split=FILE_SPLIT if data else split or "paper",
+            form=form if form or data else "lifted",
+            data=None if data is None else str(data),
+            examples=None if examples is None else str(examples),
+            variants=split_list(variants),
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
             repair_by=repair_by, repair_doubt=doubt,
         )
+        loaded = load_data(config)  # a bad file is named before the model loads
         backend = make_backend(model, mask=mask, server=server)
         try:
             results = run_ablation(config, backend, out, resume, progress=not no_progress,
-                                   concurrency=concurrency)
+                                   concurrency=concurrency, split=loaded)
         except KeyboardInterrupt:
             typer.echo(f"interrupted: finished samples are in {out}; continue with --resume",
                        err=True)

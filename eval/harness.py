@@ -13,11 +13,13 @@ from __future__ import annotations
 import os
 import platform
 import random
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field, fields, replace
+from typing import Protocol
 
 from ara import __version__
-from ara.data import PreparedSplit, Record
+from ara.data import Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
 from ara.eval.confidence import DOUBT
@@ -29,6 +31,23 @@ from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
 from ara.provenance import git_commit
 
 LETTERS = {"F": "few_shot", "P": "grammar_in_prompt", "C": "constrained"}
+
+#: What ``split`` is for a run on a user's own file (:mod:`ara.eval.user_data`).
+FILE_SPLIT = "file"
+
+
+class Split(Protocol):
+    """What a run reads of its data: a prepared split
+    (:class:`~ara.data.store.PreparedSplit`), or a user's file read as one
+    (:class:`~ara.eval.user_data.FileSplit`)."""
+
+    @property
+    def version(self) -> str: ...
+
+    @property
+    def manifest(self) -> dict: ...
+
+    def records(self, part: str, form: str | None = None) -> list[Record]: ...
 
 
 @dataclass(frozen=True)
@@ -65,8 +84,14 @@ class AblationConfig:
 
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
-            ``handwritten``, ``handwritten2``).
-        form: ``lifted`` or ``grounded`` records.
+            ``handwritten``, ``handwritten2``), or ``file``: the pairs of ``data``.
+        form: ``lifted`` or ``grounded`` records; for ``file``, None (every line) or
+            the lines of that form.
+        data: With ``split="file"``: a JSON Lines file of the user's pairs
+            (:mod:`ara.eval.user_data`), every line with its reference.
+        examples: With ``split="file"``: a file of pairs in the same format to draw
+            worked examples from (None: the compositional train side, in the tests'
+            form).
         variants: Variant names, e.g. ``("F", "F+P", "F+P+C")``.
         shots: Few-shot counts for the F variants, 0 to 50 (0: F runs zero-shot;
             variants without F always do).
@@ -92,7 +117,7 @@ class AblationConfig:
     """
 
     split: str = "paper"
-    form: str = "lifted"
+    form: str | None = "lifted"
     variants: tuple[str, ...] = ("F", "F+P", "F+P+C")
     shots: tuple[int, ...] = (5, 20)
     reruns: int = 3
@@ -105,12 +130,20 @@ class AblationConfig:
     repair: int = 0
     repair_by: str = REPAIR_BY[0]
     repair_doubt: float = DOUBT
+    data: str | None = None
+    examples: str | None = None
 
     def __post_init__(self) -> None:
-        if self.split not in SPLITS:
+        if self.split == FILE_SPLIT:
+            if self.data is None:
+                raise ConfigError("split 'file' reads the pairs of data: name the file")
+        elif self.split not in SPLITS:
             raise ConfigError(f"unknown split {self.split!r}. {did_you_mean(self.split, SPLITS)}")
-        if self.form not in FORMS:
-            raise ConfigError(f"unknown form {self.form!r}. {did_you_mean(self.form, FORMS)}")
+        elif self.data is not None or self.examples is not None:
+            raise ConfigError(f"data and examples are files of one's own pairs, for split "
+                              f"'file'; split {self.split!r} has its own")
+        if not (self.form in FORMS or self.form is None and self.split == FILE_SPLIT):
+            raise ConfigError(f"unknown form {self.form!r}. {did_you_mean(str(self.form), FORMS)}")
         object.__setattr__(self, "variants", tuple(Variant.parse(v).name for v in self.variants))
         if self.split == "timed" and not self.translator.intervals:
             # NL2TL's timed formulas carry intervals: a grammar without them could not
@@ -135,6 +168,8 @@ class AblationConfig:
         data["variants"], data["shots"] = list(self.variants), list(self.shots)
         if not self.repair:  # as runs from before repair existed wrote it: they resume
             del data["repair"], data["repair_by"], data["repair_doubt"]
+        if self.split != FILE_SPLIT:  # the same for runs from before files could be read
+            del data["data"], data["examples"]
         return data
 
     @classmethod
@@ -168,29 +203,35 @@ class Job:
         return (self.variant.name, self.shots, self.rerun, self.record.uid)
 
 
-def test_sample(config: AblationConfig, split: PreparedSplit) -> list[Record]:
+def test_sample(config: AblationConfig, split: Split) -> list[Record]:
     """The test pairs of the run: ``limit`` records drawn with ``seed``."""
     records = split.records("test", config.form)
     if not records:
-        raise ConfigError(f"split {config.split} has no {config.form} test records")
+        kind = f"{config.form} test" if config.form else "test"
+        raise ConfigError(f"split {config.split} has no {kind} records")
     if config.limit >= len(records):
         return records
     return random.Random(config.seed).sample(records, config.limit)
 
 
-def shot_pool(config: AblationConfig, split: PreparedSplit) -> list[Record]:
+def shot_pool(config: AblationConfig, split: Split) -> list[Record]:
     """Where worked examples come from: the split's own train side, or for a test-only
-    split (the hand-written suites) the compositional train side, which holds none of
-    their sentences."""
+    split (the hand-written suites, a user's file without examples) the compositional
+    train side, which holds none of the suites' sentences, in the tests' form (the
+    form most of a user's lines have)."""
     pool = split.records("train", config.form)
     if pool or not any(v.few_shot for v in map(Variant.parse, config.variants)):
         return pool
     from ara.data import load_or_prepare
 
-    return load_or_prepare("compositional", config.data_seed).records("train", config.form)
+    forms = Counter(r.form for r in split.records("test", config.form))
+    form = config.form or max(FORMS, key=lambda f: forms[f])
+    pool = load_or_prepare("compositional", config.data_seed).records("train", form)
+    tests = {r.nl for r in split.records("test")}
+    return [r for r in pool if r.nl not in tests]
 
 
-def plan(config: AblationConfig, split: PreparedSplit) -> Iterator[Job]:
+def plan(config: AblationConfig, split: Split) -> Iterator[Job]:
     """Every generation of the run, grouped so that consecutive prompts share a prefix."""
     tests = test_sample(config, split)
     pool = shot_pool(config, split)
@@ -267,7 +308,7 @@ def sample_of(job: Job, answer: Answer, timeout_s: float) -> dict:
     }
 
 
-def run_metadata(config: AblationConfig, split: PreparedSplit, model_id: str) -> dict:
+def run_metadata(config: AblationConfig, split: Split, model_id: str) -> dict:
     """What produced the run: config, model, data, grammar, code and machine."""
     return {
         "config": config.to_dict(),
@@ -276,6 +317,7 @@ def run_metadata(config: AblationConfig, split: PreparedSplit, model_id: str) ->
                  "manifest_version": split.manifest["version"]},
         "grammar_version": GRAMMAR_VERSION,
         "seed": config.seed,
+        **({"data_files": split.manifest["files"]} if config.split == FILE_SPLIT else {}),
         "ara_version": __version__,
         "git_commit": git_commit(),
         "machine": {"platform": platform.platform(), "processor": platform.machine(),

@@ -54,6 +54,12 @@ def _cell(stat: dict) -> str:
     return f"{stat['mean']:.2f} ± {stat['std']:.2f}"
 
 
+def data_name(meta: dict) -> str:
+    """The split's name, or for a run on a user's file that file's name."""
+    files = meta.get("data_files")
+    return Path(next(iter(files))).name if files else meta["data"]["split"]
+
+
 def tables_markdown(results: Results) -> str:
     """Tables shaped like the paper's Tables I (validity) and II (accuracy, containment)."""
     rows = results["results"]
@@ -62,8 +68,8 @@ def tables_markdown(results: Results) -> str:
     cell = {(r["variant"], r["shots"]): r for r in rows}
     meta = results["meta"]
     lines = [
-        f"Model `{meta['model_id']}`; data `{meta['data']['split']}` "
-        f"v{meta['data']['version']} ({meta['config']['form']}); grammar "
+        f"Model `{meta['model_id']}`; data `{data_name(meta)}` "
+        f"v{meta['data']['version']} ({meta['config']['form'] or 'every form'}); grammar "
         f"{meta['grammar_version']}; seed {meta['seed']}; {meta['config']['reruns']} reruns; "
         f"{results['counts']['samples']} samples.",
         "",
@@ -112,7 +118,7 @@ def plot_results(results: Results, path: Path) -> None:
         ax.set_title(f"{metric} (%)")
         ax.set_ylim(0, 105)
         ax.grid(axis="y", alpha=0.3)
-    fig.suptitle(f"{results['meta']['model_id']} on {results['meta']['data']['split']}",
+    fig.suptitle(f"{results['meta']['model_id']} on {data_name(results['meta'])}",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
