@@ -83,3 +83,21 @@ def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backe
         assert completion.logprob is not None, completion.text  # the tokenizer's own tokens
         assert completion.logprob == pytest.approx(backend.score(prompt, [completion.text])[0],
                                                    abs=0.5)
+
+
+def test_scores_shared_prefixes_change_only_float_rounding(hf_backend, hf_model_dir):
+    """Tests that the transformers backend, which feeds answers after the prefix they
+    share with the one before, scores each as a fresh model scoring it alone does, up
+    to float32 rounding (llama.cpp's kernels differed by up to 0.9 in a logit, so that
+    backend scores each answer alone; this one need not)."""
+    from ara.eval.backends.hf_backend import HFBackend
+
+    prompt = build_prompt("always avoid the door and eventually reach the goal",
+                          ("door", "goal"), ())
+    answers = [" G(!door) & F(goal)\n", " G(!door) & F(door)\n", " G(door)\n",
+               " F(goal) & G(!door)\n"]
+    together = hf_backend.score(prompt, answers)
+    fresh = HFBackend(hf_model_dir)
+    alone = [fresh.score(prompt, [a])[0] for a in answers]
+    assert together == pytest.approx(alone, abs=1e-4)
+    assert all(x < -1 for x in together)
