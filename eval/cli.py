@@ -264,7 +264,7 @@ def ablation_cmd(
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import load_data, run_ablation
-    from ara.eval.harness import FILE_SPLIT, AblationConfig
+    from ara.eval.harness import FILE_SPLIT, AblationConfig, check_plan
     from ara.eval.models import make_backend
     from ara.eval.report import tables_markdown
 
@@ -286,6 +286,7 @@ def ablation_cmd(
             repair_by=repair_by, repair_doubt=doubt,
         )
         loaded = load_data(config)  # a bad file is named before the model loads
+        check_plan(config, loaded)
         backend = make_backend(model, mask=mask, server=server)
         try:
             results = run_ablation(config, backend, out, resume, progress=not no_progress,

@@ -206,9 +206,11 @@ class Job:
 def test_sample(config: AblationConfig, split: Split) -> list[Record]:
     """The test pairs of the run: ``limit`` records drawn with ``seed``."""
     records = split.records("test", config.form)
+    if not records and config.split == FILE_SPLIT:
+        raise ConfigError(f"{config.data} has no {config.form} lines (--form {config.form}); "
+                          "a line is lifted when its propositions are all prop_<n>")
     if not records:
-        kind = f"{config.form} test" if config.form else "test"
-        raise ConfigError(f"split {config.split} has no {kind} records")
+        raise ConfigError(f"split {config.split} has no {config.form} test records")
     if config.limit >= len(records):
         return records
     return random.Random(config.seed).sample(records, config.limit)
@@ -229,6 +231,21 @@ def shot_pool(config: AblationConfig, split: Split) -> list[Record]:
     pool = load_or_prepare("compositional", config.data_seed).records("train", form)
     tests = {r.nl for r in split.records("test")}
     return [r for r in pool if r.nl not in tests]
+
+
+def check_plan(config: AblationConfig, split: Split) -> None:
+    """Raise now what :func:`plan` would raise later, e.g. before a model loads.
+
+    Raises:
+        ConfigError: If there is nothing to test, or fewer worked examples to draw
+            from than ``shots`` asks for.
+    """
+    test_sample(config, split)
+    asked = max(config.shots) if any(Variant.parse(v).few_shot for v in config.variants) else 0
+    pool = shot_pool(config, split) if asked else []
+    if asked > len(pool):
+        raise ConfigError(f"{asked} worked examples asked for (--shots), but only "
+                          f"{len(pool)} to draw them from")
 
 
 def plan(config: AblationConfig, split: Split) -> Iterator[Job]:

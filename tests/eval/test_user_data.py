@@ -140,6 +140,21 @@ def test_cli_refuses_a_split_and_a_file_together(tmp_path):
     assert alone.returncode == 2 and "--examples goes with --data" in alone.stderr
 
 
+def test_cli_names_what_cannot_be_planned_before_loading_a_model(tmp_path):
+    """Tests the messages for a form none of the lines has, and for more worked
+    examples than the examples file holds (each before a model would load)."""
+    data = write(tmp_path / "mine.jsonl", PAIRS[:2])
+    examples = write(tmp_path / "ex.jsonl", PAIRS[2:])
+    base = [ARA, "eval", "ablation", "--data", str(data), "--out", str(tmp_path / "run")]
+    form = subprocess.run([*base, "--form", "lifted"], capture_output=True, text=True)
+    assert form.returncode == 2 and "mine.jsonl has no lifted lines" in form.stderr
+    shots = subprocess.run([*base, "--examples", str(examples), "--variants", "F+C",
+                            "--shots", "5"], capture_output=True, text=True)
+    assert shots.returncode == 2 and "5 worked examples asked for" in shots.stderr
+    assert "only 1 to draw them from" in shots.stderr
+    assert not (tmp_path / "run").exists()
+
+
 @needs_llama
 def test_an_ablation_on_ones_own_file_is_judged_reported_and_resumed(tmp_path):
     """Tests a real run on a user's file: every line translated under C and zero-shot
