@@ -103,6 +103,8 @@ MODELS = {
     "soup-v16v17-doubt-fresh-270m": ("soup v16+v17 (shipped), as ara translate, "
                                      "history-independent backend (2026-11-25)",
                                      ("compositional", "89be643cc979")),
+    "soup-v16v17-full-270m": ("soup v16+v17 (shipped), every variant, history-independent "
+                              "backend (2026-11-25)", ("compositional", "89be643cc979")),
     "soup-v16v18-270m": ("soup v16+v18 at rank 16", ("compositional", "e910409c3f2c")),
     "soup-v11v12v13-270m": ("soup v11+v12+v13 (not shipped)", ("compositional", "9c33668eac7c")),
     "soup-v7v8-270m": ("soup v7+v8 (shipped until 2026-11-23)",
