@@ -312,6 +312,23 @@ def score_cmd(
     emit(results, as_json, tables_markdown)
 
 
+@eval_app.command("diff")
+def diff_cmd(
+    before: Path = typer.Argument(..., help="A run folder from `ara eval ablation`."),
+    after: Path = typer.Argument(..., help="Another run on the same data (a new model, "
+                                           "setting or variant)."),
+    show: int = typer.Option(10, "--show", min=0, help="Pairs listed of each kind."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object, every pair."),
+) -> None:
+    """Compare two runs answer by answer: fixed, broken, rewritten, the same (no model
+    needed). Runs of one variant each are paired even when their variants differ."""
+    from ara.eval.run_diff import diff_markdown, diff_runs
+
+    with user_errors():
+        result = diff_runs(before, after).to_dict()
+    emit(result, as_json, lambda d: diff_markdown(d, show))
+
+
 @eval_app.command("ceiling")
 def ceiling_cmd(
     split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
