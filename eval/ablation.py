@@ -14,7 +14,6 @@ from ara.eval.harness import (
     FILE_SPLIT,
     AblationConfig,
     Split,
-    check_plan,
     plan,
     run_metadata,
     sample_of,
@@ -59,7 +58,6 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
     split = load_data(config) if split is None else split
     meta = run_metadata(config, split, backend.model_id)
     translator = Translator(backend, config.translator)
-    check_plan(config, split)
     jobs = list(plan(config, split))
     with RunStore(out, meta, resume) as store:
         todo = [job for job in jobs if job.key not in store.done]

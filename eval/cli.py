@@ -264,7 +264,7 @@ def ablation_cmd(
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import load_data, run_ablation
-    from ara.eval.harness import FILE_SPLIT, AblationConfig, check_plan
+    from ara.eval.harness import FILE_SPLIT, AblationConfig, plan
     from ara.eval.models import make_backend
     from ara.eval.report import tables_markdown
 
@@ -285,8 +285,8 @@ def ablation_cmd(
             seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
             repair_by=repair_by, repair_doubt=doubt,
         )
-        loaded = load_data(config)  # a bad file is named before the model loads
-        check_plan(config, loaded)
+        loaded = load_data(config)
+        plan(config, loaded)  # a bad file or plan is named before the model loads
         backend = make_backend(model, mask=mask, server=server)
         try:
             results = run_ablation(config, backend, out, resume, progress=not no_progress,

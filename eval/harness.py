@@ -233,26 +233,28 @@ def shot_pool(config: AblationConfig, split: Split) -> list[Record]:
     return [r for r in pool if r.nl not in tests]
 
 
-def check_plan(config: AblationConfig, split: Split) -> None:
-    """Raise now what :func:`plan` would raise later, e.g. before a model loads.
+def plan(config: AblationConfig, split: Split) -> Iterator[Job]:
+    """Every generation of the run, grouped so that consecutive prompts share a prefix.
+
+    The data is checked when this is called, not when the jobs are iterated, so a
+    caller can refuse a run before loading a model.
 
     Raises:
         ConfigError: If there is nothing to test, or fewer worked examples to draw
             from than ``shots`` asks for.
     """
-    test_sample(config, split)
-    asked = max(config.shots) if any(Variant.parse(v).few_shot for v in config.variants) else 0
-    pool = shot_pool(config, split) if asked else []
-    if asked > len(pool):
-        raise ConfigError(f"{asked} worked examples asked for (--shots), but only "
-                          f"{len(pool)} to draw them from")
-
-
-def plan(config: AblationConfig, split: Split) -> Iterator[Job]:
-    """Every generation of the run, grouped so that consecutive prompts share a prefix."""
     tests = test_sample(config, split)
     pool = shot_pool(config, split)
     variants = [Variant.parse(v) for v in config.variants]
+    asked = max(config.shots) if any(v.few_shot for v in variants) else 0
+    if asked > len(pool):
+        raise ConfigError(f"{asked} worked examples asked for (--shots), but only "
+                          f"{len(pool)} to draw them from")
+    return _jobs(config, tests, pool, variants)
+
+
+def _jobs(config: AblationConfig, tests: list[Record], pool: list[Record],
+          variants: list[Variant]) -> Iterator[Job]:
     for rerun in range(config.reruns):
         groups = [(k, [v for v in variants if v.few_shot]) for k in config.shots]
         groups.append((0, [v for v in variants if not v.few_shot]))
