@@ -123,7 +123,7 @@ class LlamaCppBackend:
         limit = min(len(cached), len(tokens) - 1)  # evaluate >= 1 token to get logits
         same = np.flatnonzero(np.asarray(cached[:limit]) != np.asarray(tokens[:limit]))
         shared = int(same[0]) if same.size else limit
-        reused = min(shared, self._intact // CHUNK * CHUNK) // CHUNK * CHUNK
+        reused = shared // CHUNK * CHUNK  # shared <= _intact: cached is that long
         self.llm.n_tokens = reused
         for begin in range(reused, len(tokens), CHUNK):
             self.llm.eval(tokens[begin: begin + CHUNK])
