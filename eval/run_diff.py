@@ -113,9 +113,7 @@ def diff_samples(before: Sequence[dict], after: Sequence[dict]) -> RunDiff:
                 "rewritten_right", (False, False): "rewritten_wrong"}[(_right(a), _right(b))]
         changes.append(Change(kind, b["nl"], b["reference"], _answer(a), _answer(b), k))
     changes.sort(key=lambda c: (KINDS.index(c.kind), c.key))
-    cells = tuple(f"{x} -> {y}" for x, y in zip(cells_before, cells_after, strict=False)) \
-        if len(cells_before) == len(cells_after) else (
-            f"{', '.join(cells_before)} -> {', '.join(cells_after)}",)
+    cells = (f"{', '.join(cells_before)} -> {', '.join(cells_after)}",)
     return RunDiff(cells, len(shared), sum(_right(old[k]) for k in shared),
                    sum(_right(new[k]) for k in shared), same, tuple(changes),
                    len(old) - len(shared), len(new) - len(shared))
