@@ -107,7 +107,9 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         ``None`` where the backend cannot score); ``alternatives`` (other readings, each
         ``stl`` and ``probability``, listed only when the confidence is below
         :data:`DOUBT`); ``left_out`` (listed propositions and stated bounds the answer
-        never uses), where the answer parses.
+        never uses) and ``unasked`` (subformulas nesting temporal operators as the
+        sentence never asks for, :func:`~ara.eval.coverage.unasked`), where the answer
+        parses.
     """
     config = config or AnswerConfig()
     vote: Vote | None = None
@@ -149,6 +151,7 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
     if result.stl is not None:
         gap = gaps(nl, aps, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
+        data["unasked"] = list(gap.unasked)
     return data
 
 
@@ -180,7 +183,8 @@ def notes(data: dict) -> list[str]:
     if data["stl"] is None:
         return []
     said = []
-    gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]))
+    gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]),
+               tuple(data.get("unasked", ())))
     if gap:
         said.append(gap.warning())
     if doubted(data):

@@ -177,12 +177,14 @@ def translate_requests(translator: Translator, requests: Iterable[FileRequest], 
 
 
 def summarize(rows: Sequence[dict]) -> dict:
-    """Counts over a run's lines: answers, valid, doubted, with a gap; and where lines
+    """Counts over a run's lines: answers, valid, doubted, leaving something out, nesting
+    operators unasked; and where lines
     have references, how many the answers match (also among the undoubted)."""
     summary = {"answers": len(rows), "valid": sum(r["valid"] for r in rows),
                "doubted": sum(doubted(r) for r in rows),
                "left_out": sum(bool(r.get("left_out", {}).get("aps")
-                                    or r.get("left_out", {}).get("numbers")) for r in rows)}
+                                    or r.get("left_out", {}).get("numbers")) for r in rows),
+               "unasked": sum(bool(r.get("unasked")) for r in rows)}
     judged = [r for r in rows if "reference" in r]
     if judged:
         sure = [r for r in judged if not doubted(r)]
@@ -203,7 +205,8 @@ def summary_table(summary: dict) -> str:
 
     rows = [("valid", share(summary["valid"], n)),
             ("doubted (confidence below 0.5)", share(summary["doubted"], n)),
-            ("leave out a listed proposition or bound", share(summary["left_out"], n))]
+            ("leave out a listed proposition or bound", share(summary["left_out"], n)),
+            ("nest operators the sentence never asks for", share(summary["unasked"], n))]
     if "with_reference" in summary:
         rows += [("equivalent to the reference", share(summary["equivalent"],
                                                        summary["with_reference"])),

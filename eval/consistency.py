@@ -29,11 +29,11 @@ from dataclasses import dataclass, replace
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
 from ara.eval.confidence import DOUBT, result_score
-from ara.eval.coverage import gaps
+from ara.eval.coverage import gaps, unasked
 from ara.eval.prompt import Shot
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
-from ara.grammars.literal_edits import literal_edits
+from ara.grammars.literal_edits import literal_edits, operator_drops
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
@@ -286,12 +286,21 @@ def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
 def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
                   bounds: bool = True) -> list[str]:
     """Formulas one edit from ``stl`` that write something it leaves out of the request
-    (:func:`~ara.grammars.literal_edits.literal_edits`), kept to the request's language
-    so that each is an answer constrained decoding could have given."""
-    gap = gaps(nl, aps, parse(stl))
+    (:func:`~ara.grammars.literal_edits.literal_edits`) or drop a temporal operator the
+    sentence never asks for (:func:`~ara.grammars.literal_edits.operator_drops`, twice
+    where one drop leaves another), kept to the request's language so that each is an
+    answer constrained decoding could have given."""
+    formula = parse(stl)
+    gap = gaps(nl, aps, formula)
     syntax = translator.grammar(aps, nl).syntax
-    edits = literal_edits(parse(stl), gap.aps, gap.numbers if bounds else ())
-    return [text for text in map(to_text, edits) if syntax.accepts(text)]
+    edits = literal_edits(formula, gap.aps, gap.numbers if bounds else ())
+    # An operator the sentence never asks for is dropped; where that leaves another
+    # (F[0,200](F(G(a))) drops to F[0,200](G(a))), that one is dropped too.
+    drops = operator_drops(formula, unasked(nl, formula))
+    drops += [again for once in drops for again in operator_drops(once, unasked(nl, once))]
+    texts = dict.fromkeys(map(to_text, [*edits, *drops]))
+    texts.pop(stl, None)
+    return [text for text in texts if syntax.accepts(text)]
 
 
 def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],

@@ -1,4 +1,5 @@
-"""What an answer leaves out of its request: propositions and stated time bounds.
+"""What an answer leaves out of its request (propositions, stated time bounds) and
+what it adds that the request never asks for (nested temporal operators).
 
 A translation that never uses a proposition the user listed, or a number the sentence
 states as a bound, is wrong whatever else it says: "reach the dock within 250 steps"
@@ -6,7 +7,18 @@ has to put 250 somewhere. On the shipped fine-tune's held-out sets, 17 of the 18
 answers with such a gap were wrong (docs/generalization.md, "Repair"), so a gap is a
 cheap, precise signal to draw more answers (:func:`ara.eval.consistency.translate_repaired`).
 
-The check is one-sided on purpose: an answer with no gap can still be wrong, and a
+The converse is checked for the one slip that needs words to be right: an ``F`` and a
+``G`` nested (:mod:`ara.grammars.nesting`). ``G(F(a))`` says "a again and again" and
+``F(G(a))`` "a from some point on, for good"; a sentence with no word for either
+("Always keep a firm grip on the bottle", "reach the garden") never asks for them,
+and ``F(F(a))`` or ``F[10,25](F(a))`` no sentence means. The words that ask for each
+pair (:data:`AGAIN_AND_AGAIN_WORDS`, :data:`FOR_GOOD_WORDS`) are the training
+realizer's phrasings for them (:mod:`ara.grammars.english`), NL2TL's and their common
+synonyms; no reference of the held-out sets or the training mixture's realized
+sentences writes a pair its sentence does not ask for, bar a few NL2TL labels
+(docs/generalization.md, "Operators the sentence never asks for").
+
+The checks are one-sided on purpose: an answer with no gap can still be wrong, and a
 sentence may state a number that is not a bound ("pick up two boxes"); then no answer
 closes the gap and the greedy one is kept.
 """
@@ -18,12 +30,32 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ara.eval.translator import NUMBER_WORDS
-from ara.grammars import Formula, atoms, walk
+from ara.grammars import Formula, atoms, parse, walk
 from ara.grammars.ast import interval_of
+from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, RESTATED, nested_pairs
+from ara.grammars.printer import to_text
 
 _LIFTED = re.compile(r"prop_\d+")
 _TIME_WORDS = frozenset("step steps time second seconds minute minutes hour hours unit units "
                         "tick ticks instant instants moment moments".split())
+
+#: Words that ask for ``G(F(a))``: a again and again.
+AGAIN_AND_AGAIN_WORDS = re.compile(
+    r"\b(again|repeatedly|over and over|time and again|infinitely|often|periodic\w*"
+    r"|regularly|every so often|now and then|from time to time|always eventually"
+    r"|keep (?:on )?(?:visiting|revisiting|coming|returning|going|checking|patrolling"
+    r"|circling|cycling)|back and forth|patrol\w*|alternat\w*|recurr\w*|endless\w*"
+    r"|cycl\w*|loop\w*|round|never stops?|continual\w*|routine\w*)\b")
+#: Words that ask for ``F(G(a))``: a from some point on, for good.
+FOR_GOOD_WORDS = re.compile(
+    r"\b(stay|stays|staying|remain|remains|remaining|for good|forever|permanently"
+    r"|from (?:then|now|there) on|from (?:that|this|the|some) (?:moment|point|time|step) on"
+    r"|eventually always|thereafter|ever after|onwards?|henceforth|indefinitely|in the end"
+    r"|ultimately|ends? up|settles?|always|at all times|keep|continu\w*"
+    r"|uninterrupted\w*|consecutive\w*|consistently|(?:until|till) the (?:very )?end)\b")
+_WORDS_FOR = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS}
+_SAYS = {AGAIN_AND_AGAIN: "again and again", FOR_GOOD: "from some point on, for good",
+         RESTATED: "an operator inside the same one"}
 
 
 @dataclass(frozen=True)
@@ -33,20 +65,30 @@ class Gaps:
     Attributes:
         aps: Listed propositions the answer never uses.
         numbers: Numbers the sentence states that no interval of the answer writes.
+        unasked: Subformulas (canonical text) that nest temporal operators as the
+            sentence never asks for (:func:`unasked`).
     """
 
     aps: tuple[str, ...] = ()
     numbers: tuple[int, ...] = ()
+    unasked: tuple[str, ...] = ()
 
     def __len__(self) -> int:
-        return len(self.aps) + len(self.numbers)
+        return len(self.aps) + len(self.numbers) + len(self.unasked)
 
     def warning(self) -> str:
         """What to tell a user whose answer leaves these out: such answers were nearly
         always wrong on the held-out sets, so it should not pass silently."""
-        parts = [*(f"{ap}, a listed proposition," for ap in self.aps),
-                 *(f"the bound {n} the sentence states" for n in self.numbers)]
-        return (f"warning: this answer never uses {' or '.join(parts)}, so it most likely "
+        said = []
+        if self.aps or self.numbers:
+            parts = [*(f"{ap}, a listed proposition," for ap in self.aps),
+                     *(f"the bound {n} the sentence states" for n in self.numbers)]
+            said.append(f"never uses {' or '.join(parts)}")
+        if self.unasked:
+            said.append("writes " + " and ".join(
+                f"{text} ({_SAYS[_pair_kind(text)]})" for text in self.unasked)
+                + ", which the sentence never asks for")
+        return (f"warning: this answer {'; it also '.join(said)}, so it most likely "
                 "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
                 "sentence may help.")
 
@@ -69,12 +111,27 @@ def stated_numbers(nl: str, aps: Sequence[str]) -> frozenset[int]:
     return frozenset(numbers - named)
 
 
+def unasked(nl: str, formula: Formula) -> tuple[Formula, ...]:
+    """The nested pairs of ``formula`` (:func:`~ara.grammars.nesting.nested_pairs`)
+    that ``nl`` never asks for: every pair that restates an operator, and ``G(F)`` or
+    ``F(G)`` where the sentence has none of the words for it."""
+    text = nl.lower()
+    return tuple(node for node, kind in nested_pairs(formula)
+                 if kind == RESTATED or not _WORDS_FOR[kind].search(text))
+
+
+def _pair_kind(text: str) -> str:
+    return next(kind for _, kind in nested_pairs(parse(text)))
+
+
 def gaps(nl: str, aps: Sequence[str], formula: Formula) -> Gaps:
-    """What ``formula``, as a translation of ``nl`` over ``aps``, leaves out."""
+    """What ``formula``, as a translation of ``nl`` over ``aps``, leaves out, and the
+    nested operators it writes that ``nl`` never asks for."""
     used_aps = atoms(formula)
     written = set()
     for node in walk(formula):
         if (iv := interval_of(node)) is not None:
             written |= {iv.lo} | ({iv.hi} if iv.hi is not None else set())
     return Gaps(aps=tuple(ap for ap in aps if ap not in used_aps),
-                numbers=tuple(sorted(stated_numbers(nl, aps) - written)))
+                numbers=tuple(sorted(stated_numbers(nl, aps) - written)),
+                unasked=tuple(dict.fromkeys(map(to_text, unasked(nl, formula)))))

@@ -105,3 +105,23 @@ def _intervals_with(node: Formula, n: int) -> list[Interval]:
             ivs.append(Interval(n, iv.hi))
     return ivs
 
+
+
+def operator_drops(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
+    """Every formula with one temporal operator of a pair in ``nodes`` dropped: for each
+    occurrence of a node ``O1(O2(a))`` in ``formula``, the formula with ``O2(a)`` or
+    ``O1(a)`` in its place (a pair the sentence never asks for, such as ``G(F(a))`` for
+    "always keep a firm grip on a", :mod:`ara.grammars.nesting`).
+
+    Returns:
+        Distinct formulas (by canonical text), in a fixed order, ``formula`` excluded.
+    """
+    out: dict[str, Formula] = {}
+    targets = set(nodes)
+    for sub, rebuild in _spots(formula):
+        if sub in targets and isinstance(sub, (Eventually, Always)):
+            inner = sub.arg
+            if isinstance(inner, (Eventually, Always)):
+                _add(out, rebuild(inner), rebuild(replace(sub, arg=inner.arg)))
+    out.pop(to_text(formula), None)
+    return list(out.values())

@@ -200,6 +200,22 @@ def test_translate_warns_when_the_answer_leaves_part_of_the_request_out():
 
 
 @needs_llama
+def test_translate_repairs_and_warns_of_operators_the_sentence_never_asks_for():
+    """Tests an answer that nests F in G where the sentence never says "again and
+    again": greedy decoding (--repair 0) writes it and is warned of, in words and as
+    the `unasked` field; repair, the default, drops the F."""
+    args = ["Always hold the railing firmly.", "--aps", "hold_railing"]
+    out = ara("translate", *args, "--repair", "0")
+    assert out.returncode == 0 and out.stdout.strip() == "G(F(hold_railing))"
+    assert ("warning: this answer writes G(F(hold_railing)) (again and again), which the "
+            "sentence never asks for") in out.stderr
+    answer = json.loads(ara("translate", *args, "--repair", "0", "--json").stdout)
+    assert answer["unasked"] == ["G(F(hold_railing))"]
+    answer = json.loads(ara("translate", *args, "--json").stdout)
+    assert answer["stl"] == "G(hold_railing)" and answer["unasked"] == []
+
+
+@needs_llama
 def test_translate_notes_an_answer_the_model_doubts():
     """Tests the note and the JSON field: a sentence of words that say nothing temporal
     gets an answer the model gives a low probability, read back in English; a plain

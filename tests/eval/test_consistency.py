@@ -155,6 +155,21 @@ def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by
 
 
 @needs_llama
+def test_mends_drop_the_operators_a_sentence_never_asks_for(llama_backend):
+    """Tests the mends of an answer that nests operators unasked: "reach the dock
+    within 200 steps" asks neither for staying there nor for one F inside another, so
+    each is dropped, the second after the first, and nothing else is proposed."""
+    t = Translator(llama_backend)
+    nl, aps = "Reach the dock within 200 steps.", ("at_dock",)
+    assert gaps(nl, aps, parse("F[0,200](F(G(at_dock)))")).unasked == (
+        "F[0,200](F(G(at_dock)))", "F(G(at_dock))")
+    mends = literal_mends(t, nl, aps, "F[0,200](F(G(at_dock)))")
+    assert {"F[0,200](at_dock)", "F[0,200](G(at_dock))", "F(G(at_dock))"} <= set(mends)
+    assert "F[0,200](F(G(at_dock)))" not in mends
+    assert literal_mends(t, nl, aps, "F[0,200](at_dock)") == []
+
+
+@needs_llama
 def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
     """Tests that without intervals a stated bound is no reason to draw: no answer of
     the grammar could write it."""

@@ -1,7 +1,17 @@
-"""What an answer leaves out of its request: the signal repair acts on."""
+"""What an answer leaves out of its request, and adds unasked: the signals repair acts on."""
 
-from ara.eval.coverage import Gaps, gaps, stated_numbers
-from ara.grammars import parse
+from ara.data.synthetic import synthetic_records
+from ara.eval.coverage import (
+    AGAIN_AND_AGAIN_WORDS,
+    FOR_GOOD_WORDS,
+    Gaps,
+    gaps,
+    stated_numbers,
+    unasked,
+)
+from ara.grammars import parse, to_text
+from ara.grammars.english import PHRASES
+from ara.grammars.nesting import RESTATED, nested_pairs
 
 
 def test_a_dropped_bound_and_a_dropped_proposition_are_gaps():
@@ -37,3 +47,43 @@ def test_an_untimed_request_with_every_proposition_has_no_gap():
     nl = "( prop_1 ) or ( prop_2 ) at some point"
     assert len(gaps(nl, ["prop_1", "prop_2"], parse("F(prop_1 | prop_2)"))) == 0
     assert len(gaps(nl, ["prop_1", "prop_2"], parse("F(prop_1)"))) == 1
+
+
+def test_nesting_the_sentence_never_asks_for_is_a_gap():
+    """"Always keep a firm grip" asks for no grip again and again; "reach the garden"
+    for no staying there."""
+    grip = gaps("Always keep a firm grip on the bottle.", ["grip_bottle"],
+                parse("G(F(grip_bottle))"))
+    assert grip == Gaps(unasked=("G(F(grip_bottle))",))
+    assert "G(F(grip_bottle)) (again and again)" in grip.warning()
+    nl = "Keep away from the stairs and eventually reach the garden."
+    assert unasked(nl, parse("G(!at_stairs) & F(G(at_garden))")) == ()  # "keep": for good
+    nl = "Avoid the stairs and reach the garden."
+    assert [to_text(f) for f in unasked(nl, parse("G(!at_stairs) & F(G(at_garden))"))] == [
+        "F(G(at_garden))"]
+
+
+def test_words_for_a_pair_license_it_and_a_restated_operator_never_is():
+    assert not gaps("Inspect the forklift every so often.", ["inspect_forklift"],
+                    parse("G(F(inspect_forklift))"))
+    assert not gaps("Go to the charging station and stay there.", ["at_charging_station"],
+                    parse("F(G(at_charging_station))"))
+    nl = "between time 10 and time 25, (prop_1) must happen at least once"
+    assert gaps(nl, ["prop_1"], parse("F[10,25](F(prop_1))")).unasked == ("F[10,25](F(prop_1))",)
+    assert not gaps(nl, ["prop_1"], parse("F[10,25](prop_1)"))
+
+
+def test_the_realizer_phrasings_for_each_pair_have_the_words_for_it():
+    """Training sentences say these pairs in the realizer's words: none of them may
+    read as unasked, or repair would undo what the model learned."""
+    for key, words in (("GF", AGAIN_AND_AGAIN_WORDS), ("GF_place", AGAIN_AND_AGAIN_WORDS),
+                       ("GF2_place", AGAIN_AND_AGAIN_WORDS), ("FG", FOR_GOOD_WORDS),
+                       ("FG_place", FOR_GOOD_WORDS), ("F_then_G", FOR_GOOD_WORDS)):
+        for phrase in PHRASES[key]:
+            assert words.search(phrase.lower()), (key, phrase)
+
+
+def test_generated_sentences_never_ask_for_less_nesting_than_their_formula():
+    for record in synthetic_records(300, seed=3, held_out=False):
+        kinds = {next(nested_pairs(node))[1] for node in unasked(record.nl, parse(record.stl))}
+        assert kinds <= {RESTATED}, (record.nl, record.stl)  # random draws restate

@@ -1,0 +1,46 @@
+"""Temporal operators directly inside one another: what each such pair says.
+
+``F`` and ``G`` nested one in the other say something that needs words of its own:
+``G(F(a))`` "a again and again", ``F(G(a))`` "a from some point on, for good". The same
+operator nested in itself, with one of the two unbounded, says no more than one of
+them would (``F(F(a))`` is ``F(a)``, ``G(G(a))`` is ``G(a)``) or makes a bound void
+(``F[10,25](F(a))`` is ``F[10,inf)(a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
+asks for such a formula only by accident, so a translation that writes one has most
+likely slipped (docs/generalization.md, "Operators the sentence never asks for").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from ara.grammars.ast import Always, Eventually, Formula, walk
+
+#: The nested pairs :func:`nested_pairs` names: an operator over another, unbounded.
+AGAIN_AND_AGAIN = "G(F)"
+FOR_GOOD = "F(G)"
+RESTATED = "restated"
+
+
+def nested_pairs(formula: Formula) -> Iterator[tuple[Formula, str]]:
+    """Every ``F`` or ``G`` node of ``formula`` whose argument is an ``F`` or ``G``,
+    with what the pair says, where it says something of note:
+
+    - :data:`RESTATED`: the same operator twice, one of them unbounded;
+    - :data:`AGAIN_AND_AGAIN`: an unbounded ``G`` over an unbounded ``F``;
+    - :data:`FOR_GOOD`: an ``F`` (bounded or not) over an unbounded ``G``.
+
+    Other pairs (``G(F[0,10](a))`` "at least once in every 10 steps", ``F(G[0,5](a))``
+    "at some point, a for 5 steps", both bounded) are left out: each says what its
+    words say.
+    """
+    for node in walk(formula):
+        if not isinstance(node, (Eventually, Always)):
+            continue
+        inner = node.arg
+        if not isinstance(inner, (Eventually, Always)):
+            continue
+        if type(inner) is type(node):
+            if node.interval is None or inner.interval is None:
+                yield node, RESTATED
+        elif inner.interval is None and (isinstance(node, Eventually) or node.interval is None):
+            yield node, FOR_GOOD if isinstance(node, Eventually) else AGAIN_AND_AGAIN

@@ -1,0 +1,35 @@
+"""Temporal operators nested directly: which pairs say something of note."""
+
+from ara.grammars import parse, to_text
+from ara.grammars.literal_edits import operator_drops
+from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, RESTATED, nested_pairs
+from ara.grammars.spot_bridge import equivalent
+
+
+def pairs(stl: str) -> list[tuple[str, str]]:
+    return [(to_text(node), kind) for node, kind in nested_pairs(parse(stl))]
+
+
+def test_again_and_again_and_for_good_are_the_unbounded_pairs():
+    assert pairs("G(F(a)) & F(G(b))") == [("G(F(a))", AGAIN_AND_AGAIN), ("F(G(b))", FOR_GOOD)]
+    # "within 10 steps reach b and stay there" is for good too
+    assert pairs("F[0,10](G(b))") == [("F[0,10](G(b))", FOR_GOOD)]
+
+
+def test_pairs_whose_bounds_say_what_they_mean_are_not_named():
+    # at least once in every 10 steps; at some point, a for 5 steps; both bounded
+    assert pairs("G(F[0,10](a)) & F(G[0,5](b)) & F[0,3](F[2,4](c))") == []
+
+
+def test_an_operator_inside_the_same_one_restates_it_or_voids_a_bound():
+    for stl in ("F(F(a))", "G(G(a))", "F[10,25](F(a))", "G(G[0,5](a))"):
+        assert [kind for _, kind in pairs(stl)] == [RESTATED], stl
+    assert equivalent(parse("F[10,25](F(a))"), parse("F[10,25](a) | F[25,inf](a)"))
+
+
+def test_dropping_either_operator_of_a_pair():
+    drops = {to_text(f) for f in operator_drops(parse("G(F(grip_bottle)) & F(at_dock)"),
+                                                [parse("G(F(grip_bottle))")])}
+    assert drops == {"F(grip_bottle) & F(at_dock)", "G(grip_bottle) & F(at_dock)"}
+    # a node that is no pair, or not in the formula, gives nothing
+    assert operator_drops(parse("G(a)"), [parse("G(a)"), parse("F(G(b))")]) == []
