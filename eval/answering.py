@@ -107,9 +107,10 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         ``None`` where the backend cannot score); ``alternatives`` (other readings, each
         ``stl`` and ``probability``, listed only when the confidence is below
         :data:`DOUBT`); ``left_out`` (listed propositions and stated bounds the answer
-        never uses) and ``unasked`` (subformulas nesting temporal operators as the
-        sentence never asks for, :func:`~ara.eval.coverage.unasked`), where the answer
-        parses.
+        never uses, and ``order``: whether it orders nothing where the sentence asks
+        for one step after another) and ``unasked`` (subformulas nesting temporal
+        operators or ordering steps as the sentence never asks,
+        :func:`~ara.eval.coverage.unasked`), where the answer parses.
     """
     config = config or AnswerConfig()
     vote: Vote | None = None
@@ -150,7 +151,8 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
     data["alternatives"] = [{"stl": stl, "probability": _significant(p)} for stl, p in others]
     if result.stl is not None:
         gap = gaps(nl, aps, parse(result.stl))
-        data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers)}
+        data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers),
+                            "order": gap.unordered}
         data["unasked"] = list(gap.unasked)
     return data
 
@@ -183,8 +185,9 @@ def notes(data: dict) -> list[str]:
     if data["stl"] is None:
         return []
     said = []
-    gap = Gaps(tuple(data["left_out"]["aps"]), tuple(data["left_out"]["numbers"]),
-               tuple(data.get("unasked", ())))
+    left_out = data["left_out"]
+    gap = Gaps(tuple(left_out["aps"]), tuple(left_out["numbers"]),
+               tuple(data.get("unasked", ())), left_out.get("order", False))
     if gap:
         said.append(gap.warning())
     if doubted(data):

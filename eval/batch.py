@@ -182,8 +182,9 @@ def summarize(rows: Sequence[dict]) -> dict:
     have references, how many the answers match (also among the undoubted)."""
     summary = {"answers": len(rows), "valid": sum(r["valid"] for r in rows),
                "doubted": sum(doubted(r) for r in rows),
-               "left_out": sum(bool(r.get("left_out", {}).get("aps")
-                                    or r.get("left_out", {}).get("numbers")) for r in rows),
+               "left_out": sum(any(r.get("left_out", {}).get(k) for k in ("aps", "numbers",
+                                                                            "order"))
+                               for r in rows),
                "unasked": sum(bool(r.get("unasked")) for r in rows)}
     judged = [r for r in rows if "reference" in r]
     if judged:
@@ -205,7 +206,7 @@ def summary_table(summary: dict) -> str:
 
     rows = [("valid", share(summary["valid"], n)),
             ("doubted (confidence below 0.5)", share(summary["doubted"], n)),
-            ("leave out a listed proposition or bound", share(summary["left_out"], n)),
+            ("leave out a listed proposition, a bound or an order", share(summary["left_out"], n)),
             ("nest operators the sentence never asks for", share(summary["unasked"], n))]
     if "with_reference" in summary:
         rows += [("equivalent to the reference", share(summary["equivalent"],

@@ -33,7 +33,7 @@ from ara.eval.coverage import gaps, unasked
 from ara.eval.prompt import Shot
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
-from ara.grammars.literal_edits import literal_edits, operator_drops
+from ara.grammars.literal_edits import chained, literal_edits, operator_drops, unchained
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
@@ -286,10 +286,13 @@ def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
 def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
                   bounds: bool = True) -> list[str]:
     """Formulas one edit from ``stl`` that write something it leaves out of the request
-    (:func:`~ara.grammars.literal_edits.literal_edits`) or drop a temporal operator the
+    (:func:`~ara.grammars.literal_edits.literal_edits`), drop a temporal operator the
     sentence never asks for (:func:`~ara.grammars.literal_edits.operator_drops`, twice
-    where one drop leaves another), kept to the request's language so that each is an
-    answer constrained decoding could have given."""
+    where one drop leaves another), free steps it orders against "in any order"
+    (:func:`~ara.grammars.literal_edits.unchained`), or order steps the sentence puts
+    one after the other (:func:`~ara.grammars.literal_edits.chained`), kept to the
+    request's language so that each is an answer constrained decoding could have
+    given."""
     formula = parse(stl)
     gap = gaps(nl, aps, formula)
     syntax = translator.grammar(aps, nl).syntax
@@ -298,7 +301,9 @@ def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
     # (F[0,200](F(G(a))) drops to F[0,200](G(a))), that one is dropped too.
     drops = operator_drops(formula, unasked(nl, formula))
     drops += [again for once in drops for again in operator_drops(once, unasked(nl, once))]
-    texts = dict.fromkeys(map(to_text, [*edits, *drops]))
+    drops += unchained(formula, unasked(nl, formula))
+    chains = chained(formula) if gap.unordered else []
+    texts = dict.fromkeys(map(to_text, [*edits, *drops, *chains]))
     texts.pop(stl, None)
     return [text for text in texts if syntax.accepts(text)]
 

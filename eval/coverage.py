@@ -18,6 +18,12 @@ synonyms; no reference of the held-out sets or the training mixture's realized
 sentences writes a pair its sentence does not ask for, bar a few NL2TL labels
 (docs/generalization.md, "Operators the sentence never asks for").
 
+Order is checked both ways: "in any order" asks for no step after another, so an
+answer that writes ``F(a & F(b))`` for it adds one; "then", "after that", "one after
+the other" (:data:`SEQUENCE_WORDS`, not the "then" of "if ... then") ask for one, so an
+answer that orders nothing in time (:func:`~ara.grammars.nesting.orders_in_time`)
+leaves it out.
+
 The checks are one-sided on purpose: an answer with no gap can still be wrong, and a
 sentence may state a number that is not a bound ("pick up two boxes"); then no answer
 closes the gap and the greedy one is kept.
@@ -32,7 +38,14 @@ from dataclasses import dataclass
 from ara.eval.translator import NUMBER_WORDS
 from ara.grammars import Formula, atoms, parse, walk
 from ara.grammars.ast import interval_of
-from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, RESTATED, nested_pairs
+from ara.grammars.nesting import (
+    AGAIN_AND_AGAIN,
+    FOR_GOOD,
+    RESTATED,
+    nested_pairs,
+    orders_in_time,
+    sequenced_steps,
+)
 from ara.grammars.printer import to_text
 
 _LIFTED = re.compile(r"prop_\d+")
@@ -53,9 +66,22 @@ FOR_GOOD_WORDS = re.compile(
     r"|eventually always|thereafter|ever after|onwards?|henceforth|indefinitely|in the end"
     r"|ultimately|ends? up|settles?|always|at all times|keep|continu\w*"
     r"|uninterrupted\w*|consecutive\w*|consistently|(?:until|till) the (?:very )?end)\b")
+#: Words that order steps: "go to the dock, then charge". A ", then" after a condition
+#: ("if a, then b") orders nothing, nor does "sooner or later".
+SEQUENCE_WORDS = re.compile(
+    r"\b(and then|after that|afterwards?|followed by|one after the other|in (?:that|this) order"
+    r"|subsequently|(?<!no )(?<!sooner or )later)\b")
+_THEN = re.compile(r"[,;] then\b")
+_CONDITION = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|provided"
+                        r"|as soon as|once|while|on condition|every ?time|each time)\b")
+#: Words that ask for no order between steps.
+ANY_ORDER_WORDS = re.compile(
+    r"\b(in (?:any|either|whatever|whichever) order|(?:the )?order does not matter"
+    r"|regardless of (?:the )?order|no matter (?:the|what|which) order)\b")
 _WORDS_FOR = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS}
 _SAYS = {AGAIN_AND_AGAIN: "again and again", FOR_GOOD: "from some point on, for good",
          RESTATED: "an operator inside the same one"}
+_ORDERED = "one step after the other"
 
 
 @dataclass(frozen=True)
@@ -65,16 +91,19 @@ class Gaps:
     Attributes:
         aps: Listed propositions the answer never uses.
         numbers: Numbers the sentence states that no interval of the answer writes.
-        unasked: Subformulas (canonical text) that nest temporal operators as the
-            sentence never asks for (:func:`unasked`).
+        unasked: Subformulas (canonical text) that nest temporal operators or order
+            steps as the sentence never asks for (:func:`unasked`).
+        unordered: The sentence asks for steps one after the other and the answer
+            orders nothing in time.
     """
 
     aps: tuple[str, ...] = ()
     numbers: tuple[int, ...] = ()
     unasked: tuple[str, ...] = ()
+    unordered: bool = False
 
     def __len__(self) -> int:
-        return len(self.aps) + len(self.numbers) + len(self.unasked)
+        return len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
 
     def warning(self) -> str:
         """What to tell a user whose answer leaves these out: such answers were nearly
@@ -86,8 +115,11 @@ class Gaps:
             said.append(f"never uses {' or '.join(parts)}")
         if self.unasked:
             said.append("writes " + " and ".join(
-                f"{text} ({_SAYS[_pair_kind(text)]})" for text in self.unasked)
+                f"{text} ({_says(text)})" for text in self.unasked)
                 + ", which the sentence never asks for")
+        if self.unordered:
+            said.append("orders nothing in time, where the sentence asks for one step "
+                        "after the other")
         return (f"warning: this answer {'; it also '.join(said)}, so it most likely "
                 "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
                 "sentence may help.")
@@ -112,21 +144,38 @@ def stated_numbers(nl: str, aps: Sequence[str]) -> frozenset[int]:
 
 
 def unasked(nl: str, formula: Formula) -> tuple[Formula, ...]:
-    """The nested pairs of ``formula`` (:func:`~ara.grammars.nesting.nested_pairs`)
-    that ``nl`` never asks for: every pair that restates an operator, and ``G(F)`` or
-    ``F(G)`` where the sentence has none of the words for it."""
+    """The parts of ``formula`` that ``nl`` never asks for: the nested pairs
+    (:func:`~ara.grammars.nesting.nested_pairs`) that restate an operator, ``G(F)`` or
+    ``F(G)`` where the sentence has none of the words for it, and steps put one after
+    another (:func:`~ara.grammars.nesting.sequenced_steps`) where it says "in any
+    order"."""
     text = nl.lower()
-    return tuple(node for node, kind in nested_pairs(formula)
-                 if kind == RESTATED or not _WORDS_FOR[kind].search(text))
+    pairs = [node for node, kind in nested_pairs(formula)
+             if kind == RESTATED or not _WORDS_FOR[kind].search(text)]
+    ordered = list(sequenced_steps(formula)) if ANY_ORDER_WORDS.search(text) else []
+    return tuple(pairs + ordered)
 
 
-def _pair_kind(text: str) -> str:
-    return next(kind for _, kind in nested_pairs(parse(text)))
+def asks_for_order(nl: str) -> bool:
+    """Whether ``nl`` puts one step after another in words (:data:`SEQUENCE_WORDS`)."""
+    text = nl.lower()
+    if ANY_ORDER_WORDS.search(text):
+        return False
+    if SEQUENCE_WORDS.search(text):
+        return True
+    then = _THEN.search(text)
+    return then is not None and not _CONDITION.search(text[:then.start()])
+
+
+def _says(text: str) -> str:
+    formula = parse(text)
+    kinds = [kind for node, kind in nested_pairs(formula) if node == formula]
+    return _SAYS[kinds[0]] if kinds else _ORDERED
 
 
 def gaps(nl: str, aps: Sequence[str], formula: Formula) -> Gaps:
-    """What ``formula``, as a translation of ``nl`` over ``aps``, leaves out, and the
-    nested operators it writes that ``nl`` never asks for."""
+    """What ``formula``, as a translation of ``nl`` over ``aps``, leaves out (an order
+    too), and what it writes that ``nl`` never asks for."""
     used_aps = atoms(formula)
     written = set()
     for node in walk(formula):
@@ -134,4 +183,5 @@ def gaps(nl: str, aps: Sequence[str], formula: Formula) -> Gaps:
             written |= {iv.lo} | ({iv.hi} if iv.hi is not None else set())
     return Gaps(aps=tuple(ap for ap in aps if ap not in used_aps),
                 numbers=tuple(sorted(stated_numbers(nl, aps) - written)),
-                unasked=tuple(dict.fromkeys(map(to_text, unasked(nl, formula)))))
+                unasked=tuple(dict.fromkeys(map(to_text, unasked(nl, formula)))),
+                unordered=asks_for_order(nl) and not orders_in_time(formula))

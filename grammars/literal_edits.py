@@ -125,3 +125,48 @@ def operator_drops(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
                 _add(out, rebuild(inner), rebuild(replace(sub, arg=inner.arg)))
     out.pop(to_text(formula), None)
     return list(out.values())
+
+
+def unchained(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
+    """Every formula with one ordered step of ``nodes`` set free: ``F(a & F(b))``
+    becomes ``F(a) & F(b)`` (steps asked for "in any order")."""
+    out: dict[str, Formula] = {}
+    targets = set(nodes)
+    for sub, rebuild in _spots(formula):
+        if sub in targets and isinstance(sub, Eventually) and isinstance(sub.arg, And):
+            steps = [a for a in sub.arg.args if isinstance(a, Eventually)]
+            rest = [a for a in sub.arg.args if not isinstance(a, Eventually)]
+            if steps:
+                first = (replace(sub, arg=rest[0] if len(rest) == 1 else And(tuple(rest)))
+                         if rest else None)
+                parts = ([first] if first is not None else []) + steps
+                _add(out, rebuild(parts[0] if len(parts) == 1 else And(tuple(parts))))
+    out.pop(to_text(formula), None)
+    return list(out.values())
+
+
+def chained(formula: Formula) -> list[Formula]:
+    """Every formula with the ``F`` conjuncts of one conjunction ordered as written:
+    ``F(a) & F(b) & F(c)`` becomes ``F(a & F(b & F(c)))``, each step keeping its
+    interval (steps asked for "one after the other")."""
+    out: dict[str, Formula] = {}
+    for sub, rebuild in _spots(formula):
+        if not isinstance(sub, And):
+            continue
+        conjuncts = _conjuncts(sub)
+        steps = [c for c in conjuncts if isinstance(c, Eventually)]
+        if len(steps) < 2:
+            continue
+        chain = steps[-1]
+        for step in reversed(steps[:-1]):
+            chain = replace(step, arg=And((step.arg, chain)))
+        others = [c for c in conjuncts if not isinstance(c, Eventually)]
+        _add(out, rebuild(And((*others, chain)) if others else chain))
+    out.pop(to_text(formula), None)
+    return list(out.values())
+
+
+def _conjuncts(node: Formula) -> list[Formula]:
+    if isinstance(node, And):
+        return [c for arg in node.args for c in _conjuncts(arg)]
+    return [node]

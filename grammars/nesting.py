@@ -1,4 +1,5 @@
-"""Temporal operators directly inside one another: what each such pair says.
+"""Temporal operators inside one another: what each such pair says, and which
+formulas order steps in time.
 
 ``F`` and ``G`` nested one in the other say something that needs words of its own:
 ``G(F(a))`` "a again and again", ``F(G(a))`` "a from some point on, for good". The same
@@ -7,13 +8,17 @@ them would (``F(F(a))`` is ``F(a)``, ``G(G(a))`` is ``G(a)``) or makes a bound v
 (``F[10,25](F(a))`` is ``F[10,inf)(a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
 asks for such a formula only by accident, so a translation that writes one has most
 likely slipped (docs/generalization.md, "Operators the sentence never asks for").
+
+An ``F`` inside the conjunction of another (``F(a & F(b))``) orders two steps; "in
+any order" asks for none, and "one after the other" for one
+(docs/generalization.md, "Order the sentence asks for").
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 
-from ara.grammars.ast import Always, Eventually, Formula, walk
+from ara.grammars.ast import Always, And, Eventually, Formula, Implies, Next, Until, walk
 
 #: The nested pairs :func:`nested_pairs` names: an operator over another, unbounded.
 AGAIN_AND_AGAIN = "G(F)"
@@ -44,3 +49,30 @@ def nested_pairs(formula: Formula) -> Iterator[tuple[Formula, str]]:
                 yield node, RESTATED
         elif inner.interval is None and (isinstance(node, Eventually) or node.interval is None):
             yield node, FOR_GOOD if isinstance(node, Eventually) else AGAIN_AND_AGAIN
+
+
+def sequenced_steps(formula: Formula) -> Iterator[Formula]:
+    """Every ``F`` node of ``formula`` whose argument is a conjunction with an ``F`` in
+    it: ``F(a & F(b))``, "a, and after that b", an order between two steps."""
+    for node in walk(formula):
+        if (isinstance(node, Eventually) and isinstance(node.arg, And)
+                and any(isinstance(arg, Eventually) for arg in node.arg.args)):
+            yield node
+
+
+def orders_in_time(formula: Formula) -> bool:
+    """Whether ``formula`` puts anything after anything else: an until, a temporal
+    operator inside an ``F`` or ``G``, or an implication whose consequence is temporal
+    (``G(a -> F(b))``, "b after each a")."""
+    for node in walk(formula):
+        if isinstance(node, Until):
+            return True
+        if isinstance(node, (Eventually, Always)) and _temporal(node.arg):
+            return True
+        if isinstance(node, Implies) and _temporal(node.rhs):
+            return True
+    return False
+
+
+def _temporal(formula: Formula) -> bool:
+    return any(isinstance(node, (Eventually, Always, Next, Until)) for node in walk(formula))

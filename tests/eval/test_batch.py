@@ -86,15 +86,16 @@ def test_a_run_cut_off_mid_line_resumes_after_its_last_whole_answer(tmp_path):
 
 def test_the_summary_counts_doubted_answers_and_matches_apart():
     """Tests the summary of three answers, two with references: one right and sure,
-    one wrong and doubted that nests operators unasked, and one without a reference
-    that leaves a bound out."""
+    one wrong and doubted that nests operators unasked and leaves out an order, and one
+    without a reference that leaves a bound out."""
     rows = [{"valid": True, "confidence": 0.97, "left_out": {"aps": [], "numbers": []},
              "reference": "G(!a)", "equivalent": True},
-            {"valid": True, "confidence": 0.2, "left_out": {"aps": [], "numbers": []},
+            {"valid": True, "confidence": 0.2,
+             "left_out": {"aps": [], "numbers": [], "order": True},
              "unasked": ["F(G(b))"], "reference": "F(a & F(b))", "equivalent": False},
             {"valid": True, "confidence": None, "left_out": {"aps": [], "numbers": [5]}}]
     summary = summarize(rows)
-    assert summary == {"answers": 3, "valid": 3, "doubted": 1, "left_out": 1, "unasked": 1,
+    assert summary == {"answers": 3, "valid": 3, "doubted": 1, "left_out": 2, "unasked": 1,
                        "with_reference": 2, "equivalent": 1, "undecided": 0,
                        "undoubted_with_reference": 1, "undoubted_equivalent": 1}
     table = summary_table(summary)

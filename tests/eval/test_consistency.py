@@ -170,6 +170,18 @@ def test_mends_drop_the_operators_a_sentence_never_asks_for(llama_backend):
 
 
 @needs_llama
+def test_mends_order_steps_the_sentence_orders_and_free_those_it_does_not(llama_backend):
+    """Tests the mends of an answer that misses the order of its steps either way."""
+    t = Translator(llama_backend)
+    nl, aps = "Charge the battery, and afterwards return to the dock.", ("charge", "at_dock")
+    assert "F(charge & F(at_dock))" in literal_mends(t, nl, aps, "F(charge) & F(at_dock)")
+    nl = "Water the plants and feed the cat, in either order."
+    aps = ("water_plants", "feed_cat")
+    assert "F(water_plants) & F(feed_cat)" in literal_mends(
+        t, nl, aps, "F(water_plants & F(feed_cat))")
+
+
+@needs_llama
 def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
     """Tests that without intervals a stated bound is no reason to draw: no answer of
     the grammar could write it."""

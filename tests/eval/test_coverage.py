@@ -5,6 +5,7 @@ from ara.eval.coverage import (
     AGAIN_AND_AGAIN_WORDS,
     FOR_GOOD_WORDS,
     Gaps,
+    asks_for_order,
     gaps,
     stated_numbers,
     unasked,
@@ -83,7 +84,32 @@ def test_the_realizer_phrasings_for_each_pair_have_the_words_for_it():
             assert words.search(phrase.lower()), (key, phrase)
 
 
-def test_generated_sentences_never_ask_for_less_nesting_than_their_formula():
+def test_generated_sentences_never_ask_for_less_than_their_formula_says():
+    """Nor for an order their formula does not write: repair must not undo what the
+    model learned from them."""
     for record in synthetic_records(300, seed=3, held_out=False):
-        kinds = {next(nested_pairs(node))[1] for node in unasked(record.nl, parse(record.stl))}
+        formula = parse(record.stl)
+        kinds = {next(nested_pairs(node), (None, "order"))[1]
+                 for node in unasked(record.nl, formula)}
         assert kinds <= {RESTATED}, (record.nl, record.stl)  # random draws restate
+        assert not gaps(record.nl, record.aps, formula).unordered, (record.nl, record.stl)
+
+
+def test_an_order_asked_for_and_one_never_asked_for_are_gaps():
+    nl = "Go to the mailroom, then the gym."
+    aps = ["go_to_mailroom", "go_to_gym"]
+    assert gaps(nl, aps, parse("F(go_to_mailroom) & F(go_to_gym)")) == Gaps(unordered=True)
+    assert not gaps(nl, aps, parse("F(go_to_mailroom & F(go_to_gym))"))
+    assert "orders nothing in time" in Gaps(unordered=True).warning()
+    nl = "Visit the mailroom and the gym, in any order."
+    assert gaps(nl, aps, parse("F(go_to_mailroom & F(go_to_gym))")).unasked == (
+        "F(go_to_mailroom & F(go_to_gym))",)
+    assert not gaps(nl, aps, parse("F(go_to_mailroom) & F(go_to_gym)"))
+
+
+def test_a_then_after_a_condition_and_sooner_or_later_order_nothing():
+    assert not asks_for_order("If the door is open, then close it.")
+    assert not asks_for_order("Sooner or later, reach the balcony.")
+    assert not asks_for_order("Reach the dock no later than step 80.")
+    assert asks_for_order("Open the valve, and close it at some later point.")
+    assert asks_for_order("charge, then go back to work")

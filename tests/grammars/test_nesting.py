@@ -1,8 +1,15 @@
-"""Temporal operators nested directly: which pairs say something of note."""
+"""Temporal operators nested: which pairs say something of note, which steps are ordered."""
 
 from ara.grammars import parse, to_text
-from ara.grammars.literal_edits import operator_drops
-from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, RESTATED, nested_pairs
+from ara.grammars.literal_edits import chained, operator_drops, unchained
+from ara.grammars.nesting import (
+    AGAIN_AND_AGAIN,
+    FOR_GOOD,
+    RESTATED,
+    nested_pairs,
+    orders_in_time,
+    sequenced_steps,
+)
 from ara.grammars.spot_bridge import equivalent
 
 
@@ -33,3 +40,27 @@ def test_dropping_either_operator_of_a_pair():
     assert drops == {"F(grip_bottle) & F(at_dock)", "G(grip_bottle) & F(at_dock)"}
     # a node that is no pair, or not in the formula, gives nothing
     assert operator_drops(parse("G(a)"), [parse("G(a)"), parse("F(G(b))")]) == []
+
+
+def test_steps_one_after_the_other_and_what_orders_in_time():
+    assert [to_text(n) for n in sequenced_steps(parse("G(!c) & F(a & F(b))"))] == [
+        "F(a & F(b))"]
+    assert not list(sequenced_steps(parse("F(a) & F(b)")))
+    for stl in ("F(a & F(b))", "!b U a", "G(a -> F(b))", "G(F(a))"):
+        assert orders_in_time(parse(stl)), stl
+    for stl in ("F(a) & F(b) & G(!c)", "G(a -> b)", "F[0,25](a) & F(b)"):
+        assert not orders_in_time(parse(stl)), stl
+
+
+def test_steps_are_freed_or_chained_as_written():
+    """"Reach a and b in any order" read as a then b is freed; "a, then b, then c" read
+    as three free steps is chained in the order the conjunction writes them, each step
+    keeping its interval."""
+    ordered = parse("G(!c) & F(a & F(b))")
+    assert [to_text(f) for f in unchained(ordered, list(sequenced_steps(ordered)))] == [
+        "G(!c) & (F(a) & F(b))"]
+    chains = {to_text(f) for f in chained(parse("(F(m) & F[0,25](c)) & F(g)"))}
+    assert "F(m & F[0,25](c & F(g)))" in chains
+    for chain in chains:
+        assert orders_in_time(parse(chain))
+    assert chained(parse("F(a) & G(b)")) == []  # one step: nothing to order
