@@ -86,7 +86,7 @@ _ORDERED = "one step after the other"
 
 @dataclass(frozen=True)
 class Gaps:
-    """What an answer leaves out.
+    """What an answer leaves out of its request, and what it writes unasked.
 
     Attributes:
         aps: Listed propositions the answer never uses.
@@ -106,7 +106,7 @@ class Gaps:
         return len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
 
     def warning(self) -> str:
-        """What to tell a user whose answer leaves these out: such answers were nearly
+        """What to tell a user whose answer has these gaps: such answers were nearly
         always wrong on the held-out sets, so it should not pass silently."""
         said = []
         if self.aps or self.numbers:
