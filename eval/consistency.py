@@ -299,9 +299,10 @@ def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
     edits = literal_edits(formula, gap.aps, gap.numbers if bounds else ())
     # An operator the sentence never asks for is dropped; where that leaves another
     # (F[0,200](F(G(a))) drops to F[0,200](G(a))), that one is dropped too.
-    drops = operator_drops(formula, unasked(nl, formula))
+    added = unasked(nl, formula)
+    drops = operator_drops(formula, added)
     drops += [again for once in drops for again in operator_drops(once, unasked(nl, once))]
-    drops += unchained(formula, unasked(nl, formula))
+    drops += unchained(formula, added)
     chains = chained(formula) if gap.unordered else []
     texts = dict.fromkeys(map(to_text, [*edits, *drops, *chains]))
     texts.pop(stl, None)

@@ -193,6 +193,14 @@ def atoms(node: Formula) -> frozenset[str]:
     return frozenset(n.name for n in walk(node) if isinstance(n, Atom))
 
 
+def conjuncts(node: Formula) -> list[Formula]:
+    """The operands of ``node`` as one conjunction, in order, whatever its bracketing
+    (``[a, b, c]`` for ``(a & b) & c``); ``[node]`` if it is no conjunction."""
+    if isinstance(node, And):
+        return [c for arg in node.args for c in conjuncts(arg)]
+    return [node]
+
+
 def atoms_read_now(node: Formula) -> frozenset[str]:
     """The propositions ``node`` reads at its first instant only: those outside every
     temporal operator (``a`` in ``a -> F(b)``, none in ``G(a)``)."""

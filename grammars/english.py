@@ -42,6 +42,7 @@ from ara.grammars.ast import (
     Not,
     Or,
     Until,
+    conjuncts,
 )
 
 # {a}, {b}: operands; {n}: an upper bound from 0; {lo}, {hi}: a window; {u}: the unit,
@@ -539,13 +540,9 @@ def _is_xor(f: Formula) -> bool:
 def _visits(f: Formula) -> list[Formula] | None:
     """``F(a) & F(b) [& F(c)]`` over propositions (any bracketing) as ``[a, b(, c)]``,
     else ``None``."""
-
-    def parts(g: Formula) -> list[Formula]:
-        return [p for arg in g.args for p in parts(arg)] if isinstance(g, And) else [g]
-
     if not isinstance(f, And):
         return None
-    found = parts(f)
+    found = conjuncts(f)
     if 2 <= len(found) <= 3 and all(isinstance(g, Eventually) and g.interval is None
                                     and isinstance(g.arg, Atom) for g in found):
         return [g.arg for g in found]

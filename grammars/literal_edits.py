@@ -34,6 +34,7 @@ from ara.grammars.ast import (
     Or,
     Until,
     children,
+    conjuncts,
     with_children,
 )
 from ara.grammars.printer import to_text
@@ -106,7 +107,6 @@ def _intervals_with(node: Formula, n: int) -> list[Interval]:
     return ivs
 
 
-
 def operator_drops(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
     """Every formula with one temporal operator of a pair in ``nodes`` dropped: for each
     occurrence of a node ``O1(O2(a))`` in ``formula``, the formula with ``O2(a)`` or
@@ -153,20 +153,14 @@ def chained(formula: Formula) -> list[Formula]:
     for sub, rebuild in _spots(formula):
         if not isinstance(sub, And):
             continue
-        conjuncts = _conjuncts(sub)
-        steps = [c for c in conjuncts if isinstance(c, Eventually)]
+        operands = conjuncts(sub)
+        steps = [c for c in operands if isinstance(c, Eventually)]
         if len(steps) < 2:
             continue
         chain = steps[-1]
         for step in reversed(steps[:-1]):
             chain = replace(step, arg=And((step.arg, chain)))
-        others = [c for c in conjuncts if not isinstance(c, Eventually)]
+        others = [c for c in operands if not isinstance(c, Eventually)]
         _add(out, rebuild(And((*others, chain)) if others else chain))
     out.pop(to_text(formula), None)
     return list(out.values())
-
-
-def _conjuncts(node: Formula) -> list[Formula]:
-    if isinstance(node, And):
-        return [c for arg in node.args for c in _conjuncts(arg)]
-    return [node]
