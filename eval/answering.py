@@ -107,8 +107,10 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         ``None`` where the backend cannot score); ``alternatives`` (other readings, each
         ``stl`` and ``probability``, listed only when the confidence is below
         :data:`DOUBT`); ``left_out`` (listed propositions and stated bounds the answer
-        never uses, and ``order``: whether it orders nothing where the sentence asks
-        for one step after another) and ``unasked`` (subformulas nesting temporal
+        never uses; ``order``: whether it orders nothing where the sentence asks
+        for one step after another; ``claims``: ``G``, ``F``, ``G(F)`` the sentence asks
+        for in words and the answer never writes, :func:`~ara.eval.coverage.unclaimed`)
+        and ``unasked`` (subformulas nesting temporal
         operators or ordering steps as the sentence never asks,
         :func:`~ara.eval.coverage.unasked`), where the answer parses.
     """
@@ -152,7 +154,7 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
     if result.stl is not None:
         gap = gaps(nl, aps, parse(result.stl))
         data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers),
-                            "order": gap.unordered}
+                            "order": gap.unordered, "claims": list(gap.claims)}
         data["unasked"] = list(gap.unasked)
     return data
 
@@ -187,7 +189,8 @@ def notes(data: dict) -> list[str]:
     said = []
     left_out = data["left_out"]
     gap = Gaps(tuple(left_out["aps"]), tuple(left_out["numbers"]),
-               tuple(data.get("unasked", ())), left_out.get("order", False))
+               tuple(data.get("unasked", ())), left_out.get("order", False),
+               tuple(left_out.get("claims", ())))
     if gap:
         said.append(gap.warning())
     if doubted(data):

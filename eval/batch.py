@@ -182,8 +182,8 @@ def summarize(rows: Sequence[dict]) -> dict:
     have references, how many the answers match (also among the undoubted)."""
     summary = {"answers": len(rows), "valid": sum(r["valid"] for r in rows),
                "doubted": sum(doubted(r) for r in rows),
-               "left_out": sum(any(r.get("left_out", {}).get(k) for k in ("aps", "numbers",
-                                                                            "order"))
+               "left_out": sum(any(r.get("left_out", {}).get(k)
+                                   for k in ("aps", "numbers", "order", "claims"))
                                for r in rows),
                "unasked": sum(bool(r.get("unasked")) for r in rows)}
     judged = [r for r in rows if "reference" in r]
@@ -206,7 +206,8 @@ def summary_table(summary: dict) -> str:
 
     rows = [("valid", share(summary["valid"], n)),
             ("doubted (confidence below 0.5)", share(summary["doubted"], n)),
-            ("leave out a listed proposition, a bound or an order", share(summary["left_out"], n)),
+            ("leave out a listed proposition, a bound, an order or an operator",
+             share(summary["left_out"], n)),
             ("nest operators the sentence never asks for", share(summary["unasked"], n))]
     if "with_reference" in summary:
         rows += [("equivalent to the reference", share(summary["equivalent"],

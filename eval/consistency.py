@@ -33,7 +33,13 @@ from ara.eval.coverage import gaps, unasked
 from ara.eval.prompt import Shot
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
-from ara.grammars.literal_edits import chained, literal_edits, operator_drops, unchained
+from ara.grammars.literal_edits import (
+    chained,
+    claim_edits,
+    literal_edits,
+    operator_drops,
+    unchained,
+)
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
@@ -290,7 +296,9 @@ def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
     sentence never asks for (:func:`~ara.grammars.literal_edits.operator_drops`, twice
     where one drop leaves another), free steps it orders against "in any order"
     (:func:`~ara.grammars.literal_edits.unchained`), or order steps the sentence puts
-    one after the other (:func:`~ara.grammars.literal_edits.chained`), kept to the
+    one after the other (:func:`~ara.grammars.literal_edits.chained`), or say what
+    the sentence asks to hold, happen or recur
+    (:func:`~ara.grammars.literal_edits.claim_edits`), kept to the
     request's language so that each is an answer constrained decoding could have
     given."""
     formula = parse(stl)
@@ -304,7 +312,8 @@ def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
     drops += [again for once in drops for again in operator_drops(once, unasked(nl, once))]
     drops += unchained(formula, added)
     chains = chained(formula) if gap.unordered else []
-    texts = dict.fromkeys(map(to_text, [*edits, *drops, *chains]))
+    claims = claim_edits(formula, gap.claims)
+    texts = dict.fromkeys(map(to_text, [*edits, *drops, *chains, *claims]))
     texts.pop(stl, None)
     return [text for text in texts if syntax.accepts(text)]
 

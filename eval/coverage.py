@@ -1,5 +1,6 @@
-"""What an answer leaves out of its request (propositions, stated time bounds) and
-what it adds that the request never asks for (nested temporal operators).
+"""What an answer leaves out of its request (propositions, stated time bounds, an
+order, what should hold, happen or recur) and what it adds that the request never asks
+for (nested temporal operators, an order).
 
 A translation that never uses a proposition the user listed, or a number the sentence
 states as a bound, is wrong whatever else it says: "reach the dock within 250 steps"
@@ -24,6 +25,16 @@ the other" (:data:`SEQUENCE_WORDS`, not the "then" of "if ... then") ask for one
 answer that orders nothing in time (:func:`~ara.grammars.nesting.orders_in_time`)
 leaves it out.
 
+And what the sentence says in words must hold over time ("always", "keep", "stay",
+"never"), happen at some point ("eventually", "at some point") or happen again and
+again ("every so often", "repeatedly") the answer has to claim
+(:func:`~ara.grammars.nesting.temporal_claims`): ``F[10,20](door_locked)`` for "between
+step 10 and step 20, keep the door locked" leaves its ``G`` out (:func:`unclaimed`). The
+words (:data:`HOLDS_WORDS`, :data:`HAPPENS_WORDS`, :data:`RECURRING_WORDS`) are those that
+say so whatever the rest of the sentence; "whenever", "within" and "during" can mean
+either and are not among them (docs/generalization.md, "What the sentence asks to
+hold, happen or recur").
+
 The checks are one-sided on purpose: an answer with no gap can still be wrong, and a
 sentence may state a number that is not a bound ("pick up two boxes"); then no answer
 closes the gap and the greedy one is kept.
@@ -41,10 +52,13 @@ from ara.grammars.ast import interval_of
 from ara.grammars.nesting import (
     AGAIN_AND_AGAIN,
     FOR_GOOD,
+    HAPPENS,
+    HOLDS,
     RESTATED,
     nested_pairs,
     orders_in_time,
     sequenced_steps,
+    temporal_claims,
 )
 from ara.grammars.printer import to_text
 
@@ -78,10 +92,33 @@ _CONDITION = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|p
 ANY_ORDER_WORDS = re.compile(
     r"\b(in (?:any|either|whatever|whichever) order|(?:the )?order does not matter"
     r"|regardless of (?:the )?order|no matter (?:the|what|which) order)\b")
+#: Words that ask for something to hold over a stretch of time (:data:`HOLDS`).
+HOLDS_WORDS = re.compile(
+    r"\b(always|at all times|all the time|never(?! both)|at no time|forever|for good|permanently"
+    r"|constantly|continuously|throughout|every ?time|each time|keep|keeps|keeping"
+    r"|(?:stay|stays|staying)(?! still| at)|remain|remains|remaining|avoid\w*|until|till"
+    r"|for (?:the )?(?:next |first |whole |entire )?(?:\d+|[a-z]+ (?:steps|seconds|minutes)))\b")
+#: Words that ask for something to happen at some point (:data:`HAPPENS`).
+HAPPENS_WORDS = re.compile(
+    r"\b(eventually|at some (?:point|time|moment|step)|sooner or later|at least once"
+    r"|sometime|someday|ultimately|finally|in the end|at one point"
+    r"|(?:by|no later than|before) (?:step|time) \d+)\b")
+#: Words that ask for something again and again (:data:`AGAIN_AND_AGAIN`), a strict
+#: part of :data:`AGAIN_AND_AGAIN_WORDS`: each of these says it, not only allows it.
+RECURRING_WORDS = re.compile(
+    r"\b(again and again|repeatedly|over and over|time and again|infinitely often"
+    r"|every so often|now and then|from time to time|periodically|regularly"
+    r"|keep (?:on )?(?:visiting|revisiting|coming back|returning|going back|checking"
+    r"|patrolling|circling|cycling)|patrol\w*|back and forth"
+    r"|(?:at least )?once (?:in )?every|in every [\w-]+ (?:window|period|interval))\b")
+_ASKING = {HOLDS: HOLDS_WORDS, HAPPENS: HAPPENS_WORDS, AGAIN_AND_AGAIN: RECURRING_WORDS}
 _WORDS_FOR = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS}
 _SAYS = {AGAIN_AND_AGAIN: "again and again", FOR_GOOD: "from some point on, for good",
          RESTATED: "an operator inside the same one"}
 _ORDERED = "one step after the other"
+_CLAIMS = {HOLDS: "that anything holds over time (G)",
+           HAPPENS: "that anything happens at some point (F)",
+           AGAIN_AND_AGAIN: "that anything happens again and again (G(F))"}
 
 
 @dataclass(frozen=True)
@@ -95,15 +132,19 @@ class Gaps:
             steps as the sentence never asks for (:func:`unasked`).
         unordered: The sentence asks for steps one after the other and the answer
             orders nothing in time.
+        claims: What the sentence asks to hold over time, happen at some point or
+            happen again and again, and the answer never claims (:func:`unclaimed`).
     """
 
     aps: tuple[str, ...] = ()
     numbers: tuple[int, ...] = ()
     unasked: tuple[str, ...] = ()
     unordered: bool = False
+    claims: tuple[str, ...] = ()
 
     def __len__(self) -> int:
-        return len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
+        return (len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
+                + len(self.claims))
 
     def warning(self) -> str:
         """What to tell a user whose answer has these gaps: such answers were nearly
@@ -120,6 +161,9 @@ class Gaps:
         if self.unordered:
             said.append("orders nothing in time, where the sentence asks for one step "
                         "after the other")
+        if self.claims:
+            said.append("never says " + " or ".join(_CLAIMS[c] for c in self.claims)
+                        + ", as the sentence asks")
         return (f"warning: this answer {'; it also '.join(said)}, so it most likely "
                 "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
                 "sentence may help.")
@@ -156,6 +200,23 @@ def unasked(nl: str, formula: Formula) -> tuple[Formula, ...]:
     return tuple(pairs + ordered)
 
 
+def asked_claims(nl: str, aps: Sequence[str] = ()) -> frozenset[str]:
+    """What ``nl`` says in words must hold over time, happen at some point, or happen
+    again and again (:func:`~ara.grammars.nesting.temporal_claims`); words that name one
+    of ``aps`` ("keep apple" for ``keep_apple``) say neither."""
+    text = nl.lower()
+    for ap in aps:
+        text = re.sub(rf"\b{re.escape(ap.lower().replace('_', ' '))}\b", " ", text)
+    return frozenset(claim for claim, words in _ASKING.items() if words.search(text))
+
+
+def unclaimed(nl: str, aps: Sequence[str], formula: Formula) -> tuple[str, ...]:
+    """What ``nl`` asks to hold, happen or recur that ``formula`` never claims, in the
+    order :data:`HOLDS`, :data:`HAPPENS`, :data:`AGAIN_AND_AGAIN`."""
+    missing = asked_claims(nl, aps) - temporal_claims(formula)
+    return tuple(claim for claim in _ASKING if claim in missing)
+
+
 def asks_for_order(nl: str) -> bool:
     """Whether ``nl`` puts one step after another in words (:data:`SEQUENCE_WORDS`)."""
     text = nl.lower()
@@ -175,7 +236,8 @@ def _says(text: str) -> str:
 
 def gaps(nl: str, aps: Sequence[str], formula: Formula) -> Gaps:
     """What ``formula``, as a translation of ``nl`` over ``aps``, leaves out (an order
-    too), and what it writes that ``nl`` never asks for."""
+    and what should hold, happen or recur too), and what it writes that ``nl`` never
+    asks for."""
     used_aps = atoms(formula)
     written = set()
     for node in walk(formula):
@@ -184,4 +246,5 @@ def gaps(nl: str, aps: Sequence[str], formula: Formula) -> Gaps:
     return Gaps(aps=tuple(ap for ap in aps if ap not in used_aps),
                 numbers=tuple(sorted(stated_numbers(nl, aps) - written)),
                 unasked=tuple(dict.fromkeys(map(to_text, unasked(nl, formula)))),
-                unordered=asks_for_order(nl) and not orders_in_time(formula))
+                unordered=asks_for_order(nl) and not orders_in_time(formula),
+                claims=unclaimed(nl, aps, formula))

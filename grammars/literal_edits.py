@@ -33,10 +33,12 @@ from ara.grammars.ast import (
     Not,
     Or,
     Until,
+    atoms,
     children,
     conjuncts,
     with_children,
 )
+from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, is_temporal
 from ara.grammars.printer import to_text
 
 Rebuild = Callable[[Formula], Formula]
@@ -164,3 +166,68 @@ def chained(formula: Formula) -> list[Formula]:
         _add(out, rebuild(And((*others, chain)) if others else chain))
     out.pop(to_text(formula), None)
     return list(out.values())
+
+
+def claim_edits(formula: Formula, claims: Sequence[str]) -> list[Formula]:
+    """Every formula one edit from ``formula`` that makes one of ``claims``
+    (:func:`~ara.grammars.nesting.temporal_claims`) the sentence asks for and it lacks:
+
+    - :data:`~ara.grammars.nesting.HOLDS` ("keep the door locked between step 10 and
+      20", "go there and stay there"): an ``F`` becomes a ``G`` with its interval, or
+      ``F(G(s))``; a part with no temporal operator ``s`` becomes ``G(s)``, a conjunction
+      of two such ``a & b`` becomes ``a U b`` or ``b U a``;
+    - :data:`~ara.grammars.nesting.HAPPENS` ("never during the first 20 seconds, but at
+      some point"): a ``G`` becomes an ``F``, ``s`` becomes ``F(s)``, the formula gains a
+      conjunct ``F(a)`` for one of its propositions;
+    - :data:`~ara.grammars.nesting.AGAIN_AND_AGAIN` ("every so often", "at least once in
+      every 10-step window"): ``G(s)`` becomes ``G(F(s))`` (``G[0,10](s)`` also
+      ``G(F[0,10](s))``), ``F(s)`` becomes ``G(F(s))``, and ``s`` becomes ``G(F(s))``.
+
+    Returns:
+        Distinct formulas (by canonical text), in a fixed order, ``formula`` excluded.
+    """
+    out: dict[str, Formula] = {}
+    parts = {id(node) for node in _plain_parts(formula)}
+    for sub, rebuild in _spots(formula):
+        plain = id(sub) in parts
+        for claim in claims:
+            if claim == HOLDS:
+                if isinstance(sub, Eventually):
+                    _add(out, rebuild(Always(sub.arg, sub.interval)))
+                    if not is_temporal(sub.arg):
+                        _add(out, rebuild(replace(sub, arg=Always(sub.arg))))
+                if plain:
+                    _add(out, rebuild(Always(sub)))
+                if plain and isinstance(sub, And) and len(sub.args) == 2:
+                    a, b = sub.args
+                    _add(out, rebuild(Until(a, b)), rebuild(Until(b, a)))
+            elif claim == HAPPENS:
+                if isinstance(sub, Always):
+                    _add(out, rebuild(Eventually(sub.arg, sub.interval)))
+                if plain:
+                    _add(out, rebuild(Eventually(sub)))
+            elif claim == AGAIN_AND_AGAIN:
+                if isinstance(sub, Always) and not isinstance(sub.arg, Eventually):
+                    _add(out, rebuild(replace(sub, arg=Eventually(sub.arg))))
+                    if sub.interval is not None:
+                        _add(out, rebuild(Always(Eventually(sub.arg, sub.interval))))
+                if isinstance(sub, Eventually):
+                    _add(out, rebuild(Always(sub)))
+                if plain:
+                    _add(out, rebuild(Always(Eventually(sub))))
+    if HAPPENS in claims:
+        for ap in sorted(atoms(formula)):
+            _add(out, And((formula, Eventually(Atom(ap)))))
+    out.pop(to_text(formula), None)
+    return list(out.values())
+
+
+def _plain_parts(node: Formula, under_operator: bool = False) -> Iterator[Formula]:
+    """The largest parts of ``node`` with no temporal operator, bar those an ``F`` or
+    ``G`` already applies to (their edits are the operator's own)."""
+    if not is_temporal(node):
+        if not under_operator:
+            yield node
+        return
+    for kid in children(node):
+        yield from _plain_parts(kid, isinstance(node, (Eventually, Always)))

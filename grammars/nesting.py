@@ -12,18 +12,41 @@ likely slipped (docs/generalization.md, "Operators the sentence never asks for")
 An ``F`` inside the conjunction of another (``F(a & F(b))``) orders two steps; "in
 any order" asks for none, and "one after the other" for one
 (docs/generalization.md, "Order the sentence asks for").
+
+What a formula says over time, whatever operators it uses to say it
+(:func:`temporal_claims`): that something holds over a stretch of time
+(:data:`HOLDS`: ``G``, or a negated ``F``: ``!F(a)`` is ``G(!a)``), that something happens
+at some point (:data:`HAPPENS`), that it happens again and again (:data:`AGAIN_AND_AGAIN`:
+a claim to happen inside a claim to hold). A sentence that says "always", "at some
+point" or "repeatedly" asks for one of these (docs/generalization.md, "What the
+sentence asks to hold, happen or recur").
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 
-from ara.grammars.ast import Always, And, Eventually, Formula, Implies, Next, Until, walk
+from ara.grammars.ast import (
+    Always,
+    And,
+    Eventually,
+    Formula,
+    Iff,
+    Implies,
+    Next,
+    Not,
+    Until,
+    children,
+    walk,
+)
 
 #: The nested pairs :func:`nested_pairs` names: an operator over another, unbounded.
 AGAIN_AND_AGAIN = "G(F)"
 FOR_GOOD = "F(G)"
 RESTATED = "restated"
+#: What :func:`temporal_claims` names besides :data:`AGAIN_AND_AGAIN`.
+HOLDS = "G"
+HAPPENS = "F"
 
 
 def nested_pairs(formula: Formula) -> Iterator[tuple[Formula, str]]:
@@ -67,12 +90,45 @@ def orders_in_time(formula: Formula) -> bool:
     for node in walk(formula):
         if isinstance(node, Until):
             return True
-        if isinstance(node, (Eventually, Always)) and _temporal(node.arg):
+        if isinstance(node, (Eventually, Always)) and is_temporal(node.arg):
             return True
-        if isinstance(node, Implies) and _temporal(node.rhs):
+        if isinstance(node, Implies) and is_temporal(node.rhs):
             return True
     return False
 
 
-def _temporal(formula: Formula) -> bool:
+def is_temporal(formula: Formula) -> bool:
+    """Whether ``formula`` has a temporal operator anywhere."""
     return any(isinstance(node, (Eventually, Always, Next, Until)) for node in walk(formula))
+
+
+def temporal_claims(formula: Formula) -> frozenset[str]:
+    """What ``formula`` claims over time: :data:`HOLDS` for a ``G``, :data:`HAPPENS` for
+    an ``F``, :data:`AGAIN_AND_AGAIN` for an ``F`` inside a ``G``, each read as written
+    and through negations too (``!F(a)`` also holds, ``G(a -> F(b))`` also recurs, an
+    until both holds and happens): the words of a sentence name the operators its
+    formula writes ("if at some point a, b" is ``F(a) -> b``) as often as what they
+    mean."""
+    return frozenset(_claims(formula, positive=True) | _claims(formula, positive=None))
+
+
+def _claims(node: Formula, positive: bool | None) -> set[str]:
+    """Claims read through negations (``positive``: the polarity of ``node``), or as
+    written where ``positive`` is None."""
+    flip = None if positive is None else not positive
+    if isinstance(node, Not):
+        return _claims(node.arg, flip)
+    if isinstance(node, Implies):
+        return _claims(node.lhs, flip) | _claims(node.rhs, positive)
+    if isinstance(node, Iff) and positive is not None:
+        return set().union(*(_claims(side, sign) for side in (node.lhs, node.rhs)
+                             for sign in (True, False)))
+    if isinstance(node, Until):
+        return {HOLDS, HAPPENS} | _claims(node.lhs, positive) | _claims(node.rhs, positive)
+    if isinstance(node, (Eventually, Always)):
+        inner = _claims(node.arg, positive)
+        holds = isinstance(node, Always) == (positive is not False)
+        if holds and HAPPENS in inner:
+            inner.add(AGAIN_AND_AGAIN)
+        return inner | {HOLDS if holds else HAPPENS}
+    return set().union(*(_claims(kid, positive) for kid in children(node)))

@@ -109,6 +109,9 @@ MODELS = {
     "soup-v16v17-order-270m": ("soup v16+v17 (shipped), as ara translate, repair also "
                                "on order left out or unasked (2026-11-25)",
                                ("compositional", "89be643cc979")),
+    "soup-v16v17-claims-270m": ("soup v16+v17 (shipped), as ara translate, repair also "
+                                "on G, F, G(F) asked for in words (2026-11-25)",
+                                ("compositional", "89be643cc979")),
     "soup-v16v17-full-270m": ("soup v16+v17 (shipped), every variant, history-independent "
                               "backend (2026-11-25)", ("compositional", "89be643cc979")),
     "soup-v16v18-270m": ("soup v16+v18 at rank 16", ("compositional", "e910409c3f2c")),

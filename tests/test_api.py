@@ -36,7 +36,7 @@ def test_translate_gives_the_command_s_answer_and_keeps_the_model_loaded():
     answer = ara.translate("Never enter the server room.", ["enter_server_room"])
     assert answer["stl"] == "G(!enter_server_room)" and answer["valid"]
     assert answer["confidence"] > 0.9 and answer["alternatives"] == []
-    assert answer["left_out"] == {"aps": [], "numbers": [], "order": False}
+    assert answer["left_out"] == {"aps": [], "numbers": [], "order": False, "claims": []}
     assert answer["unasked"] == []
     timed = ara.translate("within 20 steps reach ( prop_1 )", ["prop_1"], repair=0)
     assert timed["stl"] == "F[0,20](prop_1)" and "samples" not in timed  # greedy

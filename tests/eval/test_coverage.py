@@ -5,21 +5,24 @@ from ara.eval.coverage import (
     AGAIN_AND_AGAIN_WORDS,
     FOR_GOOD_WORDS,
     Gaps,
+    asked_claims,
     asks_for_order,
     gaps,
     stated_numbers,
     unasked,
+    unclaimed,
 )
 from ara.grammars import parse, to_text
 from ara.grammars.english import PHRASES
-from ara.grammars.nesting import RESTATED, nested_pairs
+from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, RESTATED, nested_pairs
 
 
 def test_a_dropped_bound_and_a_dropped_proposition_are_gaps():
     nl = "At some point go to the kitchen, never go to the garage, and charge within 20 steps."
     aps = ["go_to_kitchen", "go_to_garage", "charge"]
+    # "never" asks for something to hold over time, which neither F says
     assert gaps(nl, aps, parse("F(go_to_kitchen) & F(charge)")) == Gaps(
-        aps=("go_to_garage",), numbers=(20,))
+        aps=("go_to_garage",), numbers=(20,), claims=("G",))
     assert not gaps(nl, aps, parse("F(go_to_kitchen) & G(!go_to_garage) & F[0,20](charge)"))
 
 
@@ -113,3 +116,37 @@ def test_a_then_after_a_condition_and_sooner_or_later_order_nothing():
     assert not asks_for_order("Reach the dock no later than step 80.")
     assert asks_for_order("Open the valve, and close it at some later point.")
     assert asks_for_order("charge, then go back to work")
+
+
+def test_what_the_sentence_asks_to_hold_happen_or_recur_and_the_answer_never_says():
+    nl = "Between step 10 and step 20, keep the door locked."
+    assert gaps(nl, ["door_locked"], parse("F[10,20](door_locked)")) == Gaps(claims=(HOLDS,))
+    assert not gaps(nl, ["door_locked"], parse("G[10,20](door_locked)"))
+    nl = "Do not enter the loading bay during the first 20 seconds, but enter it at some point."
+    assert unclaimed(nl, ["enter_loading_bay"], parse("G[0,20](!enter_loading_bay)")) == (
+        HAPPENS,)
+    nl = "Inspect the forklift every so often."
+    assert unclaimed(nl, ["inspect_forklift"], parse("G(inspect_forklift)")) == (
+        AGAIN_AND_AGAIN,)
+    assert "never says that anything happens again and again (G(F)), as the sentence asks" in (
+        gaps(nl, ["inspect_forklift"], parse("G(inspect_forklift)")).warning())
+    # "never" is read through negations: !F(a) says G(!a)
+    assert not unclaimed("Never enter the lab.", ["enter_lab"], parse("!F(enter_lab)"))
+
+
+def test_words_that_name_a_proposition_or_say_no_time_ask_for_nothing():
+    # "keep apple" names keep_apple; "stay at the lab" names at_lab in the realizer's words;
+    # "a or b, never both" is an exclusive or; "within 10 steps" may hold or happen
+    assert asked_claims("keep apple and at any time visit the tree",
+                        ["keep_apple", "visit_tree"]) == set()
+    assert asked_claims("Stay at the lab, then bring the tool.") == set()
+    assert asked_claims("Wait, stay still, and then leave.") == set()
+    assert asked_claims("(prop_1) or (prop_2), never both.") == set()
+    assert asked_claims("reach (prop_1) within 10 steps") == set()
+    assert asked_claims("Go to the dock and stay there.") == {HOLDS}
+
+
+def test_generated_sentences_never_ask_for_a_claim_their_formula_lacks():
+    """Repair must not undo what the model learned from the realizer's sentences."""
+    for record in synthetic_records(600, seed=5, held_out=False):
+        assert not unclaimed(record.nl, record.aps, parse(record.stl)), (record.nl, record.stl)

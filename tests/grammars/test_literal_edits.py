@@ -5,7 +5,8 @@ from hypothesis import strategies as st
 
 from ara.grammars import atoms, parse, to_text, walk
 from ara.grammars.ast import interval_of
-from ara.grammars.literal_edits import literal_edits
+from ara.grammars.literal_edits import claim_edits, literal_edits
+from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, temporal_claims
 
 from conftest import formulas
 
@@ -59,4 +60,31 @@ def test_every_edit_writes_something_that_was_left_out(formula, aps, bounds):
         written = {n for node in walk(edit) if (iv := interval_of(node)) is not None
                    for n in (iv.lo, iv.hi)}
         assert atoms(edit) & set(aps) or written & set(bounds), to_text(edit)
+        assert to_text(edit) != original
+
+
+def test_a_claim_the_sentence_asks_for_is_one_edit_away():
+    def edits(stl: str, claim: str) -> set[str]:
+        return {to_text(f) for f in claim_edits(parse(stl), [claim])}
+
+    # "between step 10 and step 20, keep the door locked"
+    assert "G[10,20](door_locked)" in edits("F[10,20](door_locked)", HOLDS)
+    # "go to the charging station and stay there"
+    assert "F(drop & F(G(at_station)))" in edits("F(drop & F(at_station))", HOLDS)
+    # "(a) should happen, and (b) should hold until then"
+    assert "b U a" in edits("a & b", HOLDS)
+    # "never during the first 20 seconds, but at some point"
+    assert "G[0,20](!enter_bay) & F(enter_bay)" in edits("G[0,20](!enter_bay)", HAPPENS)
+    # "inspect the forklift every so often", "at least once in every 10-step window"
+    assert "G(F(inspect_forklift))" in edits("G(inspect_forklift)", AGAIN_AND_AGAIN)
+    assert "G(F[0,10](a))" in edits("G[0,10](a)", AGAIN_AND_AGAIN)
+
+
+@settings(max_examples=60, deadline=None)
+@given(formulas(aps=("a", "b"), timed=True, max_bound=20),
+       st.sampled_from([HOLDS, HAPPENS, AGAIN_AND_AGAIN]))
+def test_every_claim_edit_makes_the_claim_it_was_asked_for(formula, claim):
+    original = to_text(formula)
+    for edit in claim_edits(formula, [claim]):
+        assert claim in temporal_claims(edit), (original, to_text(edit))
         assert to_text(edit) != original

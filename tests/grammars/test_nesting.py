@@ -5,10 +5,13 @@ from ara.grammars.literal_edits import chained, operator_drops, unchained
 from ara.grammars.nesting import (
     AGAIN_AND_AGAIN,
     FOR_GOOD,
+    HAPPENS,
+    HOLDS,
     RESTATED,
     nested_pairs,
     orders_in_time,
     sequenced_steps,
+    temporal_claims,
 )
 from ara.grammars.spot_bridge import equivalent
 
@@ -64,3 +67,19 @@ def test_steps_are_freed_or_chained_as_written():
     for chain in chains:
         assert orders_in_time(parse(chain))
     assert chained(parse("F(a) & G(b)")) == []  # one step: nothing to order
+
+
+def test_what_a_formula_claims_over_time_read_as_written_and_through_negations():
+    def claims(stl: str) -> set[str]:
+        return set(temporal_claims(parse(stl)))
+
+    assert claims("G(F(a))") == {HOLDS, HAPPENS, AGAIN_AND_AGAIN}
+    assert claims("F[10,20](door_locked)") == {HAPPENS}
+    assert claims("G[0,10](a)") == {HOLDS}
+    assert claims("!(a & b)") == set()  # "never both" needs a G this lacks
+    assert claims("!F(a)") == {HOLDS, HAPPENS}  # G(!a), written with an F
+    assert claims("G(a -> F[0,5](b))") == {HOLDS, HAPPENS, AGAIN_AND_AGAIN}
+    assert claims("a U b") == {HOLDS, HAPPENS}
+    # "every so often" is no G over a proposition, nor "stay there" an F alone
+    assert AGAIN_AND_AGAIN not in claims("G(inspect_forklift)")
+    assert HOLDS not in claims("F(drop_package & F(at_charging_station))")
