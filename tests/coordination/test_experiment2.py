@@ -195,4 +195,5 @@ def test_helpers_share_one_translation_of_a_request(llama_backend):
     assert other is not first and shared.translate(nl, aps) is not first  # forgotten
     vote = translate_repaired(shared, nl, aps, samples=2)
     assert vote.results[0] is shared.translate(nl, aps)  # repair's greedy call, kept
-    assert len(vote.results) in (1, 3)  # the greedy answer, or it and 2 samples
+    # the greedy answer alone, or with 2 samples and the greedy answer's mends
+    assert len(vote.results) == 1 or len(vote.results) >= 3
