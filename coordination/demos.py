@@ -127,7 +127,7 @@ def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
         # Answered and checked as `ara translate` does, so the demo shows what a user gets
         data = answer(translator, errand.nl, aps)
         stl, source = data["stl"], f"translated by {translator.backend.model_id}"
-        warnings, probability = notes(data), data["confidence"]
+        warnings, probability = notes(data, errand.nl), data["confidence"]
     echo(f"[STL, {source}] {stl}")
     for warning in warnings:
         echo(warning)

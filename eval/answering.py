@@ -180,10 +180,11 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str],
     return sample_shots(pool, k, random.Random(seed))
 
 
-def notes(data: dict) -> list[str]:
+def notes(data: dict, nl: str = "") -> list[str]:
     """What to tell a user about an answer (:func:`answer`'s dict), as ``ara translate``
-    prints it on stderr: what it leaves out of the request, and, if the model doubts
-    it, the answer read back with the other readings it weighed."""
+    prints it on stderr: what it leaves out of the request (quoting the words of ``nl``
+    that ask for it), and, if the model doubts it, the answer read back with the other
+    readings it weighed."""
     if data["stl"] is None:
         return []
     said = []
@@ -192,7 +193,7 @@ def notes(data: dict) -> list[str]:
                tuple(data.get("unasked", ())), left_out.get("order", False),
                tuple(left_out.get("claims", ())))
     if gap:
-        said.append(gap.warning())
+        said.append(gap.warning(nl))
     if doubted(data):
         others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
         said.append(doubt_warning(data["stl"], data["confidence"], others))

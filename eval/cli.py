@@ -114,7 +114,7 @@ def translate_cmd(
                          doubt=doubt, temperature=temperature,
                          grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
                          alternatives=alternatives)
-    for note in [] if as_json else notes(data):  # JSON users read the fields
+    for note in [] if as_json else notes(data, nl):  # JSON users read the fields
         typer.echo(note, err=True)
     emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
 

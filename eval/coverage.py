@@ -146,9 +146,10 @@ class Gaps:
         return (len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
                 + len(self.claims))
 
-    def warning(self) -> str:
+    def warning(self, nl: str = "") -> str:
         """What to tell a user whose answer has these gaps: such answers were nearly
-        always wrong on the held-out sets, so it should not pass silently."""
+        always wrong on the held-out sets, so it should not pass silently. Given the
+        sentence ``nl``, the words that ask for a claim left out are quoted."""
         said = []
         if self.aps or self.numbers:
             parts = [*(f"{ap}, a listed proposition," for ap in self.aps),
@@ -162,8 +163,10 @@ class Gaps:
             said.append("orders nothing in time, where the sentence asks for one step "
                         "after the other")
         if self.claims:
-            said.append("never says " + " or ".join(_CLAIMS[c] for c in self.claims)
-                        + ", as the sentence asks")
+            said.append("never says " + " or ".join(
+                _CLAIMS[c] + (f', which "{word}" asks for' if (word := asking_word(nl, c))
+                              else ", as the sentence asks")
+                for c in self.claims))
         return (f"warning: this answer {'; it also '.join(said)}, so it most likely "
                 "misreads the sentence. Read it back with `ara stl explain`; rephrasing the "
                 "sentence may help.")
@@ -208,6 +211,13 @@ def asked_claims(nl: str, aps: Sequence[str] = ()) -> frozenset[str]:
     for ap in aps:
         text = re.sub(rf"\b{re.escape(ap.lower().replace('_', ' '))}\b", " ", text)
     return frozenset(claim for claim, words in _ASKING.items() if words.search(text))
+
+
+def asking_word(nl: str, claim: str) -> str | None:
+    """The first words of ``nl`` that ask for ``claim`` ("stay" for :data:`HOLDS`), if
+    any."""
+    found = _ASKING[claim].search(nl.lower())
+    return found.group(0) if found else None
 
 
 def unclaimed(nl: str, aps: Sequence[str], formula: Formula) -> tuple[str, ...]:
