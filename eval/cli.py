@@ -46,16 +46,19 @@ TEMPERATURE = typer.Option(0.7, "--temperature", min=0.01,
                            help="Sampling temperature for --samples and --repair.")
 REPAIR_OPTION = typer.Option(
     None, "--repair", min=0, max=32,
-    help=f"When the greedy answer leaves out a proposition in --aps or a number the "
-         f"sentence states as time, look for an answer that leaves out less (a "
-         f"complete greedy answer costs nothing more), drawing K answers under the "
-         f"grammar (see --repair-by). Default {REPAIR}, or 0 with --samples; 0: off.")
+    help=f"When the greedy answer has a gap (it leaves out a proposition in --aps, a "
+         f"number the sentence states as time, an order it asks for with 'then', or an "
+         f"'always', 'at some point' or 'again and again' it asks for in words; or it "
+         f"nests F and G or orders steps where the sentence has no words for that), look "
+         f"for an answer with fewer gaps (a greedy answer with none costs nothing "
+         f"more), drawing K answers under the grammar (see --repair-by). Default "
+         f"{REPAIR}, or 0 with --samples; 0: off.")
 REPAIR_BY_OPTION = typer.Option(
     REPAIR_BY[0], "--repair-by",
     help="samples+edits: the K answers drawn and the formulas one edit from the "
-         "greedy answer that write what it left out; the one the model scores "
-         "highest of those that leave out least wins. edits: the edits alone. "
-         "samples: the majority of the K drawn that leave out least (also what the "
+         "greedy answer that close a gap; the one the model scores "
+         "highest of those with the fewest gaps wins. edits: the edits alone. "
+         "samples: the majority of the K drawn with the fewest gaps (also what the "
          "others do with an HTTP --model, which cannot score).")
 DOUBT_OPTION = typer.Option(
     DOUBT, "--doubt", min=0.0, max=1.0,
@@ -98,11 +101,14 @@ def translate_cmd(
 ) -> None:
     """Translate one instruction into STL over the given propositions.
 
-    Prints the formula. On stderr: a warning when it leaves out a listed
-    proposition or a stated bound, and a note with the formula read back in
+    Prints the formula. On stderr: a warning when it still has a gap after
+    repair (see --repair: a listed proposition, a stated bound, an asked-for order
+    or 'always' / 'at some point' / 'again and again' left out, or operators
+    nested unasked), and a note with the formula read back in
     English when the model gives its answer a probability below 0.5 (about
     half of such held-out answers were wrong), with the other readings it
-    weighed. --json has them as "confidence" and "alternatives".
+    weighed. --json has them as "left_out", "unasked", "confidence" and
+    "alternatives".
     """
     from ara.api import translate
     from ara.eval.answering import notes
@@ -249,9 +255,9 @@ def ablation_cmd(
              "them); samples are still written in order, and --resume works as usual."),
     repair: int = typer.Option(
         0, "--repair", min=0, max=32,
-        help="Constrained variants: when the greedy answer leaves out a listed proposition "
-             "or a number the sentence states, look for an answer that leaves out less, "
-             "drawing K more (see --repair-by). 0 (the paper's variants): greedy."),
+        help="Constrained variants: when the greedy answer has a gap (as `ara translate "
+             "--repair` says), look for an answer with fewer gaps, drawing K more (see "
+             "--repair-by). 0 (the paper's variants): greedy."),
     repair_by: str = typer.Option(
         REPAIR_BY[0], "--repair-by",
         help="samples+edits (the model's best-scored of the K drawn and the greedy "
