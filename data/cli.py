@@ -20,7 +20,10 @@ def prepare_cmd(
     split: list[str] = typer.Option(
         list(SPLITS), "--split",
         help="paper (random 4,500/3,000 rows of navi), disjoint (no lifted formula on both "
-             "sides), timed (NL2TL's own train/dev). Repeat for several [default: all].",
+             "sides), timed (NL2TL's own train/dev), compositional (the training mixture "
+             "and its held-out shapes and phrasings), handwritten, handwritten2, "
+             "handwritten3 (the hand-written suites, test only). Repeat for several "
+             "[default: all].",
     ),
     seed: int = typer.Option(0, "--seed", help="Shuffle seed (timed ignores it)."),
     root: Path = ROOT_OPT,

@@ -4,7 +4,10 @@ training mixture includes them.
 
 ``handwritten/suite.yaml`` (split ``handwritten``, 164 entries) guided the synthetic
 generator's later versions through its misses; ``handwritten/suite2.yaml`` (split
-``handwritten2``, 109 entries) was written after that and is only ever scored.
+``handwritten2``, 109 entries) was written after that and never guided data, but its
+misses, with the first suite's, guided which slips repair checks for;
+``handwritten/suite3.yaml`` (split ``handwritten3``, 65 entries) was written after those
+checks and is their blind measure.
 """
 
 from __future__ import annotations
@@ -20,8 +23,9 @@ from ara.grammars import atoms, parse, to_text
 
 SUITE = Path(__file__).parent / "handwritten" / "suite.yaml"
 SUITE2 = Path(__file__).parent / "handwritten" / "suite2.yaml"
+SUITE3 = Path(__file__).parent / "handwritten" / "suite3.yaml"
 #: Each hand-written split and its file; a split's records carry its name as source.
-SUITES = {"handwritten": SUITE, "handwritten2": SUITE2}
+SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3}
 
 
 @dataclass(frozen=True)

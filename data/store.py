@@ -35,10 +35,11 @@ from ara.provenance import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
-SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten", "handwritten2")
+SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten", "handwritten2",
+          "handwritten3")
 FORMS = ("lifted", "grounded")
 #: Splits fixed by their files, whatever the seed.
-UNSEEDED = ("timed", "handwritten", "handwritten2")
+UNSEEDED = ("timed", "handwritten", "handwritten2", "handwritten3")
 
 
 class DataVersionWarning(UserWarning):
@@ -116,8 +117,9 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
         split: ``paper`` (random 4,500/3,000 rows of navi), ``disjoint`` (no lifted
             formula on both sides), ``timed`` (NL2TL's own train/dev, seed unused) or
             ``compositional`` (the training mixture; test: held-out synthetic shapes
-            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten`` and
-            ``handwritten2`` (the hand-written suites, test only; seed unused).
+            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten``,
+            ``handwritten2`` and ``handwritten3`` (the hand-written suites, test only;
+            seed unused).
         seed: Shuffle seed.
         root: Parent folder; :func:`default_root` by default.
     """

@@ -219,8 +219,8 @@ def ablation_cmd(
     split: str | None = typer.Option(
         None, "--split",
         help="paper (the default), disjoint, timed, compositional (held-out shapes and "
-             "phrasings), handwritten (the hand-written suite) or handwritten2 (the "
-             "second, never read for data)."),
+             "phrasings), handwritten (the hand-written suite), handwritten2 (the "
+             "second, never read for data) or handwritten3 (the third, never read at all)."),
     data: Path | None = typer.Option(
         None, "--data", dir_okay=False,
         help="Your own pairs instead of a split: JSON Lines as `ara translate-file` reads, "

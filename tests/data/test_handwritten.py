@@ -7,13 +7,13 @@ import re
 
 import pytest
 
-from ara.data.handwritten import SUITE, SUITE2, SUITES, load_suite, suite_records
+from ara.data.handwritten import SUITE, SUITE2, SUITE3, SUITES, load_suite, suite_records
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
 from ara.grammars.spot_bridge import equivalent
 
 #: The least each suite holds: entries, and entries with a time bound.
-SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40)}
+SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15)}
 
 
 @pytest.fixture(scope="module", params=sorted(SUITES))
@@ -59,9 +59,11 @@ def test_no_suite_sentence_occurs_in_any_training_source(suite):
     assert [e.nl for e in entries if _norm(e.nl) in seen] == []
 
 
-def test_the_second_suite_repeats_no_sentence_of_the_first():
+def test_each_suite_repeats_no_sentence_of_an_earlier_one():
     first = {_norm(e.nl) for e in load_suite(SUITE)}
     assert [e.nl for e in load_suite(SUITE2) if _norm(e.nl) in first] == []
+    earlier = first | {_norm(e.nl) for e in load_suite(SUITE2)}
+    assert [e.nl for e in load_suite(SUITE3) if _norm(e.nl) in earlier] == []
 
 
 @pytest.mark.parametrize("split", sorted(SUITES))
