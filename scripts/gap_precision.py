@@ -6,7 +6,7 @@ and how many wrong.
 
     .venv/bin/python scripts/gap_precision.py [--run RUN] [--variant C] [--json] [--show N]
 
-Sets: both hand-written suites, the compositional test side, NL2TL's timed dev file,
+Sets: the three hand-written suites, the compositional test side, NL2TL's timed dev file,
 the paper split's test side, and the compositional training mixture (whose NL2TL labels
 are noisy). Kinds: ``aps`` and ``numbers`` (a listed proposition, a stated bound left
 out), ``unasked`` (operators nested or steps ordered unasked), ``order`` (an order asked
@@ -42,6 +42,7 @@ def reference_sets() -> dict[str, list]:
     compositional = load_or_prepare("compositional")
     return {"hand-written suite": suite_records("handwritten"),
             "second suite": suite_records("handwritten2"),
+            "third suite": suite_records("handwritten3"),
             "compositional test": compositional.records("test"),
             "NL2TL timed dev": load_or_prepare("timed").records("test"),
             "paper split, test side": load_or_prepare("paper").records("test"),
