@@ -92,7 +92,9 @@ _CONDITION = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|p
 ANY_ORDER_WORDS = re.compile(
     r"\b(in (?:any|either|whatever|whichever) order|(?:the )?order does not matter"
     r"|regardless of (?:the )?order|no matter (?:the|what|which) order)\b")
-#: Words that ask for something to hold over a stretch of time (:data:`HOLDS`).
+#: Words that ask for something to hold over a stretch of time (:data:`HOLDS`). "Stay
+#: still" and "stay at the kitchen" name propositions in the realizer's words (``wait``,
+#: ``at_kitchen``), and "a or b, never both" is an exclusive or, so those ask nothing.
 HOLDS_WORDS = re.compile(
     r"\b(always|at all times|all the time|never(?! both)|at no time|forever|for good|permanently"
     r"|constantly|continuously|throughout|every ?time|each time|keep|keeps|keeping"
@@ -206,18 +208,24 @@ def unasked(nl: str, formula: Formula) -> tuple[Formula, ...]:
 def asked_claims(nl: str, aps: Sequence[str] = ()) -> frozenset[str]:
     """What ``nl`` says in words must hold over time, happen at some point, or happen
     again and again (:func:`~ara.grammars.nesting.temporal_claims`); words that name one
-    of ``aps`` ("keep apple" for ``keep_apple``) say neither."""
-    text = nl.lower()
-    for ap in aps:
-        text = re.sub(rf"\b{re.escape(ap.lower().replace('_', ' '))}\b", " ", text)
+    of ``aps`` ("keep apple" for ``keep_apple``) ask for none."""
+    text = _unnamed(nl, aps)
     return frozenset(claim for claim, words in _ASKING.items() if words.search(text))
 
 
-def asking_word(nl: str, claim: str) -> str | None:
+def asking_word(nl: str, claim: str, aps: Sequence[str] = ()) -> str | None:
     """The first words of ``nl`` that ask for ``claim`` ("stay" for :data:`HOLDS`), if
-    any."""
-    found = _ASKING[claim].search(nl.lower())
+    any, not counting words that name one of ``aps``."""
+    found = _ASKING[claim].search(_unnamed(nl, aps))
     return found.group(0) if found else None
+
+
+def _unnamed(nl: str, aps: Sequence[str]) -> str:
+    """``nl`` in lower case with the words that spell a proposition's name blanked."""
+    text = nl.lower()
+    for ap in aps:
+        text = re.sub(rf"\b{re.escape(ap.lower().replace('_', ' '))}\b", " ", text)
+    return text
 
 
 def unclaimed(nl: str, aps: Sequence[str], formula: Formula) -> tuple[str, ...]:
