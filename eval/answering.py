@@ -152,10 +152,7 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
                                              limit=1 + config.alternatives)[1:]]
     data["alternatives"] = [{"stl": stl, "probability": _significant(p)} for stl, p in others]
     if result.stl is not None:
-        gap = gaps(nl, aps, parse(result.stl))
-        data["left_out"] = {"aps": list(gap.aps), "numbers": list(gap.numbers),
-                            "order": gap.unordered, "claims": list(gap.claims)}
-        data["unasked"] = list(gap.unasked)
+        data |= gaps(nl, aps, parse(result.stl)).to_json()
     return data
 
 
@@ -188,10 +185,7 @@ def notes(data: dict, nl: str = "") -> list[str]:
     if data["stl"] is None:
         return []
     said = []
-    left_out = data["left_out"]
-    gap = Gaps(tuple(left_out["aps"]), tuple(left_out["numbers"]),
-               tuple(data.get("unasked", ())), left_out.get("order", False),
-               tuple(left_out.get("claims", ())))
+    gap = Gaps.from_json(data)
     if gap:
         said.append(gap.warning(nl))
     if doubted(data):

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from ara.errors import AraError, ConfigError
 from ara.eval.answering import AnswerConfig, answer, doubted
+from ara.eval.coverage import Gaps
 from ara.eval.harness import judge
 from ara.eval.prompt import Shot
 from ara.eval.translator import Translator, TranslatorConfig, check_request
@@ -182,10 +183,9 @@ def summarize(rows: Sequence[dict]) -> dict:
     have references, how many the answers match (also among the undoubted)."""
     summary = {"answers": len(rows), "valid": sum(r["valid"] for r in rows),
                "doubted": sum(doubted(r) for r in rows),
-               "left_out": sum(any(r.get("left_out", {}).get(k)
-                                   for k in ("aps", "numbers", "order", "claims"))
+               "left_out": sum(any(k != "unasked" for k in Gaps.from_json(r).kinds())
                                for r in rows),
-               "unasked": sum(bool(r.get("unasked")) for r in rows)}
+               "unasked": sum(bool(Gaps.from_json(r).unasked) for r in rows)}
     judged = [r for r in rows if "reference" in r]
     if judged:
         sure = [r for r in judged if not doubted(r)]

@@ -123,6 +123,11 @@ _CLAIMS = {HOLDS: "that anything holds over time (G)",
            AGAIN_AND_AGAIN: "that anything happens again and again (G(F))"}
 
 
+#: The kinds of gap :class:`Gaps` holds: listed propositions and stated bounds left
+#: out, operators nested or steps ordered unasked, an order and claims left out.
+KINDS = ("aps", "numbers", "unasked", "order", "claims")
+
+
 @dataclass(frozen=True)
 class Gaps:
     """What an answer leaves out of its request, and what it writes unasked.
@@ -147,6 +152,28 @@ class Gaps:
     def __len__(self) -> int:
         return (len(self.aps) + len(self.numbers) + len(self.unasked) + self.unordered
                 + len(self.claims))
+
+    def kinds(self) -> list[str]:
+        """The kinds of gap held (:data:`KINDS`), in that order."""
+        held = {"aps": self.aps, "numbers": self.numbers, "unasked": self.unasked,
+                "order": self.unordered, "claims": self.claims}
+        return [kind for kind in KINDS if held[kind]]
+
+    def to_json(self) -> dict:
+        """The gaps as ``ara translate --json`` writes them: ``left_out`` (``aps``,
+        ``numbers``, ``order``, ``claims``) and ``unasked``."""
+        return {"left_out": {"aps": list(self.aps), "numbers": list(self.numbers),
+                             "order": self.unordered, "claims": list(self.claims)},
+                "unasked": list(self.unasked)}
+
+    @classmethod
+    def from_json(cls, data: dict) -> Gaps:
+        """The gaps of an answer as :meth:`to_json` wrote them (no gap where ``data``
+        has no fields for them: an answer that did not parse, or an older file)."""
+        left_out = data.get("left_out") or {}
+        return cls(tuple(left_out.get("aps", ())), tuple(left_out.get("numbers", ())),
+                   tuple(data.get("unasked", ())), left_out.get("order", False),
+                   tuple(left_out.get("claims", ())))
 
     def warning(self, nl: str = "") -> str:
         """What to tell a user whose answer has these gaps: such answers were nearly

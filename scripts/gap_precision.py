@@ -24,18 +24,10 @@ from pathlib import Path
 
 from ara.data import load_or_prepare
 from ara.data.handwritten import suite_records
-from ara.eval.coverage import Gaps, gaps
+from ara.eval.coverage import KINDS, gaps
 from ara.grammars import parse
 
-KINDS = ("aps", "numbers", "unasked", "order", "claims")
 RESULTS = Path("docs/results/generalization")
-
-
-def kinds_of(gap: Gaps) -> list[str]:
-    """The kinds of gap ``gap`` holds, in :data:`KINDS` order."""
-    held = {"aps": gap.aps, "numbers": gap.numbers, "unasked": gap.unasked,
-            "order": gap.unordered, "claims": gap.claims}
-    return [kind for kind in KINDS if held[kind]]
 
 
 def reference_sets() -> dict[str, list]:
@@ -53,7 +45,7 @@ def flagged_references(records: list, show: int) -> tuple[Counter, list[str]]:
     counts: Counter = Counter()
     shown = []
     for r in records:
-        kinds = kinds_of(gaps(r.nl, r.aps, parse(r.stl)))
+        kinds = gaps(r.nl, r.aps, parse(r.stl)).kinds()
         counts.update(kinds)
         if kinds and len(shown) < show:
             shown.append(f"{'/'.join(kinds)}: {r.nl} -> {r.stl}")
@@ -70,7 +62,7 @@ def flagged_answers(run: Path, variant: str) -> dict[str, dict[str, Counter]]:
             if row.get("variant") != variant or not row.get("stl"):
                 continue
             verdict = "right" if row["equivalent"] else "wrong"
-            for kind in kinds_of(gaps(row["nl"], row["aps"], parse(row["stl"]))):
+            for kind in gaps(row["nl"], row["aps"], parse(row["stl"])).kinds():
                 per_kind[kind][verdict] += 1
         out[samples.parent.name] = per_kind
     return out

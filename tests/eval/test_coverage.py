@@ -153,3 +153,12 @@ def test_generated_sentences_never_ask_for_a_claim_their_formula_lacks():
     """Repair must not undo what the model learned from the realizer's sentences."""
     for record in synthetic_records(600, seed=5, held_out=False):
         assert not unclaimed(record.nl, record.aps, parse(record.stl)), (record.nl, record.stl)
+
+
+def test_kinds_of_a_gap_in_a_fixed_order_and_its_json_round_trip():
+    gap = Gaps(aps=("a",), unasked=("G(F(b))",), unordered=True, claims=("G",))
+    assert gap.kinds() == ["aps", "unasked", "order", "claims"]
+    assert gap.to_json() == {"left_out": {"aps": ["a"], "numbers": [], "order": True,
+                                          "claims": ["G"]}, "unasked": ["G(F(b))"]}
+    assert Gaps.from_json(gap.to_json()) == gap
+    assert not Gaps.from_json({"stl": None})  # an answer that did not parse has no fields

@@ -4,8 +4,6 @@ import importlib.util
 import json
 from pathlib import Path
 
-from ara.eval.coverage import Gaps
-
 SCRIPT = Path(__file__).parents[2] / "scripts" / "gap_precision.py"
 spec = importlib.util.spec_from_file_location("gap_precision", SCRIPT)
 gap_precision = importlib.util.module_from_spec(spec)
@@ -25,8 +23,3 @@ def test_flagged_answers_are_counted_right_or_wrong_per_kind(tmp_path):
         "\n".join(json.dumps(r) for r in rows))
     counts = gap_precision.flagged_answers(tmp_path, "C")["handwritten-grounded"]
     assert counts["claims"] == {"wrong": 1} and not counts["order"]
-
-
-def test_kinds_of_a_gap_in_a_fixed_order():
-    gap = Gaps(aps=("a",), unordered=True, claims=("G",))
-    assert gap_precision.kinds_of(gap) == ["aps", "order", "claims"]
