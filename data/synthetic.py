@@ -21,7 +21,7 @@ on its own ("go to the kitchen") means *at some point*, and is written
 ``G(a -> ...)`` with ``a`` alone: there an achievement may be said as an event
 ("whenever you pick up the red box, ...").
 
-Version 3 (after reading the shipped fine-tune's misses, docs/generalization.md) draws
+Version 3 (after reading the shipped fine-tune's misses, docs/what-moved.md) draws
 three-step sequences, which version 2's depth limit of 4 had silently rejected, says
 conditions or lasting actions where version 2 said any command around "whenever", and
 adds the visit pattern and "in that order" / "in any order". Version 3.1 brings back

@@ -105,10 +105,10 @@ def translate_cmd(
     repair (see --repair: a listed proposition, a stated bound, an asked-for order
     or 'always' / 'at some point' / 'again and again' left out, or operators
     nested unasked), and a note with the formula read back in
-    English when the model gives its answer a probability below 0.5 (about
-    half of such held-out answers were wrong), with the other readings it
-    weighed. --json has them as "left_out", "unasked", "confidence" and
-    "alternatives".
+    English when the model gives its answer a probability below 0.5, with
+    the other readings it weighed. --json has them as "left_out", "unasked",
+    "confidence" and "alternatives". How often such answers are wrong:
+    docs/model-card.md.
     """
     from ara.api import translate
     from ara.eval.answering import notes

@@ -2,15 +2,14 @@
 
 The model's probability of its own answer, teacher-forced after the very prompt it
 answered (:meth:`~ara.eval.translator.Translator.score`), separates right from wrong
-answers well on the held-out sets: an area under the ROC curve of 0.86 over 473
-answers of the shipped fine-tune (docs/generalization.md, "How sure the model is").
-86% of the right answers are above 0.5, against 37% of the wrong ones; a sentence the
-model cannot read ("( prop_1 ) purple elephant ( prop_2 )") gets an answer under 0.1.
+answers well on the held-out sets (measured in docs/model-card.md, "How repair and the
+confidence note work"); a sentence the model cannot read ("( prop_1 ) purple elephant
+( prop_2 )") gets a low one.
 
-It mostly flags: the model scores the reference above its own wrong answer in 12 of
-99 misses, and keeping the majority of 8 samples where it doubts did worse than the
-greedy answer. Those 12 are search errors, which repair now looks for: where the model
-doubts a complete answer, it keeps the best-scored of it and 8 samples
+It mostly flags: the model seldom scores the reference above its own wrong answer, and
+keeping the majority of samples where it doubts did worse than the greedy answer. Where
+it does, greedy decoding missed a likelier answer, and repair looks for it: where the
+model doubts a complete answer, it keeps the best-scored of it and the samples
 (:func:`~ara.eval.consistency.translate_repaired`). A user who sees the flag reads the
 answer back (`ara stl explain`) or rewords the sentence.
 """
@@ -30,9 +29,8 @@ if TYPE_CHECKING:  # consistency imports DOUBT from here
     from ara.eval.consistency import Vote
 
 #: Below this probability an answer is flagged. Chosen on the compositional test side,
-#: where flagged answers were wrong 60% of the time; on the two hand-written suites and
-#: NL2TL's timed dev file it flags 15% of the answers, half of them wrong, and 90% of the
-#: unflagged ones are right (84% of all).
+#: where the answers below it were more often wrong than right, and then checked on the
+#: other held-out sets (docs/model-card.md).
 DOUBT = 0.5
 
 

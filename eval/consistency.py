@@ -42,10 +42,8 @@ from ara.grammars.literal_edits import (
 )
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
-#: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. By
-#: samples+edits on gaps it fixed 8 of 473 held-out greedy answers and lost none, acting
-#: on 18 (by samples alone 4); on doubted answers too, 16 fixed and 2 lost, acting on
-#: 118 (docs/generalization.md, "Repair by the model's score", "How sure the model is").
+#: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. What
+#: each way of repairing fixed and broke on the held-out sets: docs/what-moved.md.
 DEFAULT_REPAIR = 8
 
 #: How repair looks for a better answer (see :func:`translate_repaired`).

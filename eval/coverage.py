@@ -4,9 +4,8 @@ for (nested temporal operators, an order).
 
 A translation that never uses a proposition the user listed, or a number the sentence
 states as a bound, is wrong whatever else it says: "reach the dock within 250 steps"
-has to put 250 somewhere. On the shipped fine-tune's held-out sets, 17 of the 18
-answers with such a gap were wrong (docs/generalization.md, "Repair"), so a gap is a
-cheap, precise signal to draw more answers (:func:`ara.eval.consistency.translate_repaired`).
+has to put 250 somewhere. On the shipped fine-tune's held-out sets nearly every answer
+with such a gap was wrong (docs/model-card.md), so a gap is a cheap, precise signal to draw more answers (:func:`ara.eval.consistency.translate_repaired`).
 
 The converse is checked for the one slip that needs words to be right: an ``F`` and a
 ``G`` nested (:mod:`ara.grammars.nesting`). ``G(F(a))`` says "a again and again" and
@@ -16,8 +15,7 @@ and ``F(F(a))`` or ``F[10,25](F(a))`` no sentence means. The words that ask for 
 pair (:data:`AGAIN_AND_AGAIN_WORDS`, :data:`FOR_GOOD_WORDS`) are the training
 realizer's phrasings for them (:mod:`ara.grammars.english`), NL2TL's and their common
 synonyms; no reference of the held-out sets or the training mixture's realized
-sentences writes a pair its sentence does not ask for, bar a few NL2TL labels
-(docs/generalization.md, "Operators the sentence never asks for").
+sentences writes a pair its sentence does not ask for, bar a few NL2TL labels.
 
 Order is checked both ways: "in any order" asks for no step after another, so an
 answer that writes ``F(a & F(b))`` for it adds one; "then", "after that", "one after
@@ -32,8 +30,7 @@ again ("every so often", "repeatedly") the answer has to claim
 step 10 and step 20, keep the door locked" leaves its ``G`` out (:func:`unclaimed`). The
 words (:data:`HOLDS_WORDS`, :data:`HAPPENS_WORDS`, :data:`RECURRING_WORDS`) are those that
 say so whatever the rest of the sentence; "whenever", "within" and "during" can mean
-either and are not among them (docs/generalization.md, "What the sentence asks to
-hold, happen or recur").
+either and are not among them.
 
 The checks are one-sided on purpose: an answer with no gap can still be wrong, and a
 sentence may state a number that is not a bound ("pick up two boxes"); then no answer

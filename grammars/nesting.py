@@ -7,19 +7,17 @@ operator nested in itself, with one of the two unbounded, says no more than one 
 them would (``F(F(a))`` is ``F(a)``, ``G(G(a))`` is ``G(a)``) or makes a bound void
 (``F[10,25](F(a))`` is ``F[10,inf)(a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
 asks for such a formula only by accident, so a translation that writes one has most
-likely slipped (docs/generalization.md, "Operators the sentence never asks for").
+likely slipped (docs/model-card.md, "How repair and the confidence note work").
 
 An ``F`` inside the conjunction of another (``F(a & F(b))``) orders two steps; "in
-any order" asks for none, and "one after the other" for one
-(docs/generalization.md, "Order the sentence asks for").
+any order" asks for none, and "one after the other" for one.
 
 What a formula says over time, whatever operators it uses to say it
 (:func:`temporal_claims`): that something holds over a stretch of time
 (:data:`HOLDS`: ``G``, or a negated ``F``: ``!F(a)`` is ``G(!a)``), that something happens
 at some point (:data:`HAPPENS`), that it happens again and again (:data:`AGAIN_AND_AGAIN`:
 a claim to happen inside a claim to hold). A sentence that says "always", "at some
-point" or "repeatedly" asks for one of these (docs/generalization.md, "What the
-sentence asks to hold, happen or recur").
+point" or "repeatedly" asks for one of these.
 """
 
 from __future__ import annotations

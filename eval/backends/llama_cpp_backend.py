@@ -2,8 +2,8 @@
 
 Decoding is our own greedy loop over ``Llama.eval`` rather than ``create_completion``,
 for two reasons. Constraint: llguidance's mask replaces llama.cpp's built-in grammar
-sampler, which checks the whole 262k-token vocabulary at every step (about 2.5x slower
-per formula, measured by ``bench/constrained_overhead.py``). The built-in sampler stays
+sampler, which checks the whole 262k-token vocabulary at every step (slower per
+formula, as ``bench/constrained_overhead.py`` measures). The built-in sampler stays
 available (``mask="llama"``) for faithfulness to the paper's setup. Prefix reuse: the
 longest common token prefix with the previous prompt keeps its KV cache, so a run that
 shares its few-shot examples evaluates them once. The cache is full-size
@@ -13,12 +13,11 @@ position once it has slid past it.
 An answer must not depend on what was asked before it. llama.cpp's CPU kernels give a
 position's scores a little differently depending on where it falls in the batch that
 computed it (a quantized matrix product takes rows four at a time and the leftover
-ones another way): on the embedded model, up to 0.9 in a logit, enough to change a
-sampled answer or the ranking of two close ones. So prompts are fed in chunks that
-start at fixed positions (multiples of :data:`CHUNK`), only whole chunks are reused,
-and asking the same prompt again (the samples of one request) reuses its scores
-rather than re-feeding its last token: every position is computed the way a fresh
-model computes it, whatever came before.
+ones another way), enough to change a sampled answer or the ranking of two close ones.
+So prompts are fed in chunks that start at fixed positions (multiples of :data:`CHUNK`),
+only whole chunks are reused, and asking the same prompt again (the samples of one
+request) reuses its scores rather than re-feeding its last token: every position is
+computed the way a fresh model computes it, whatever came before.
 """
 
 from __future__ import annotations
