@@ -220,7 +220,8 @@ def ablation_cmd(
         None, "--split",
         help="paper (the default), disjoint, timed, compositional (held-out shapes and "
              "phrasings), handwritten (the hand-written suite), handwritten2 (the "
-             "second, never read for data) or handwritten3 (the third, never read at all)."),
+             "second, never read for data), handwritten3 (the third, never read at all) "
+             "or handwritten4 (the fourth, blind, in new domains)."),
     data: Path | None = typer.Option(
         None, "--data", dir_okay=False,
         help="Your own pairs instead of a split: JSON Lines as `ara translate-file` reads, "

@@ -84,8 +84,8 @@ class AblationConfig:
 
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
-            ``handwritten``, ``handwritten2``, ``handwritten3``), or ``file``: the pairs
-            of ``data``.
+            ``handwritten``, ``handwritten2``, ``handwritten3``, ``handwritten4``), or
+            ``file``: the pairs of ``data``.
         form: ``lifted`` or ``grounded`` records; for ``file``, None (every line) or
             the lines of that form.
         data: With ``split="file"``: a JSON Lines file of the user's pairs

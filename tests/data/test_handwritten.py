@@ -7,13 +7,20 @@ import re
 
 import pytest
 
-from ara.data.handwritten import SUITE, SUITE2, SUITE3, SUITES, load_suite, suite_records
+from ara.data.handwritten import SUITE, SUITE2, SUITE3, SUITE4, SUITES, load_suite, suite_records
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
 from ara.grammars.spot_bridge import equivalent
 
 #: The least each suite holds: entries, and entries with a time bound.
-SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15)}
+SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15),
+         "handwritten4": (150, 60)}
+#: Each suite's domains: the fourth's grounded ones are ones no earlier suite covers.
+FIRST_DOMAINS = {"lifted", "navigation", "manipulation", "warehouse"}
+DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
+           "handwritten3": FIRST_DOMAINS,
+           "handwritten4": {"lifted", "household", "drones", "hospital", "manufacturing",
+                            "agriculture"}}
 
 
 @pytest.fixture(scope="module", params=sorted(SUITES))
@@ -29,7 +36,7 @@ def test_suite_covers_what_the_issue_asks(suite):
     assert len(entries) >= least
     assert sum("[" in e.stl for e in entries) >= least_timed
     assert {e.form for e in entries} == {"lifted", "grounded"}
-    assert {e.domain for e in entries} == {"lifted", "navigation", "manipulation", "warehouse"}
+    assert {e.domain for e in entries} == DOMAINS[name]
 
 
 def test_every_reference_differs_from_the_readings_it_must_not_be_confused_with(suite):
@@ -64,6 +71,8 @@ def test_each_suite_repeats_no_sentence_of_an_earlier_one():
     assert [e.nl for e in load_suite(SUITE2) if _norm(e.nl) in first] == []
     earlier = first | {_norm(e.nl) for e in load_suite(SUITE2)}
     assert [e.nl for e in load_suite(SUITE3) if _norm(e.nl) in earlier] == []
+    earlier |= {_norm(e.nl) for e in load_suite(SUITE3)}
+    assert [e.nl for e in load_suite(SUITE4) if _norm(e.nl) in earlier] == []
 
 
 @pytest.mark.parametrize("split", sorted(SUITES))
