@@ -40,7 +40,7 @@ from ara.data.normalize import (
     RejectedRow,
     normalize_navi,
     normalize_timed,
-    read_jsonl,
+    read_raw,
 )
 from ara.data.splits import paper_split
 from ara.data.synthetic import (
@@ -49,7 +49,6 @@ from ara.data.synthetic import (
     is_held_out,
     synthetic_records,
 )
-from ara.provenance import sha256_file
 
 #: Rows of each part; a change here is a new version of the split.
 SYNTHETIC_TRAIN_ROWS = 4700
@@ -79,12 +78,12 @@ def compositional_split(raw_dir: Path, seed: int
     Returns:
         ``(parts, rejected, sources)`` as :func:`ara.data.store.build_split` does.
     """
-    navi_rows = read_jsonl(raw_dir / "navi.jsonl")
+    navi_rows, navi_hash = read_raw(raw_dir, "navi.jsonl")
     navi, rejected = normalize_navi(navi_rows)
     navi_train = paper_split(navi, len(navi_rows), seed)["train"]
     lifted = _dedup([r for r in navi_train if r.form == "lifted"])
-    timed, rejected_timed = normalize_timed(read_jsonl(raw_dir / "lifted_stl_train.jsonl"),
-                                            "nl2tl_timed_train")
+    timed_rows, timed_hash = read_raw(raw_dir, "lifted_stl_train.jsonl")
+    timed, rejected_timed = normalize_timed(timed_rows, "nl2tl_timed_train")
     settings = SynthSettings()
     # A held-out shape stays out of training whatever the source wrote it.
     nl2tl = [r for r in lifted + _dedup(timed)
@@ -95,8 +94,7 @@ def compositional_split(raw_dir: Path, seed: int
     suite = {sentence_key(r.nl) for split in SUITES for r in suite_records(split)}
     train = [r for r in train if sentence_key(r.nl) not in suite]
     test = synthetic_records(SYNTHETIC_TEST_ROWS, seed, held_out=True, settings=settings)
-    sources = {name: sha256_file(raw_dir / name)
-               for name in ("navi.jsonl", "lifted_stl_train.jsonl")}
+    sources = {"navi.jsonl": navi_hash, "lifted_stl_train.jsonl": timed_hash}
     sources["timed_labels"] = TIMED_LABELS_VERSION
     sources["synthetic"] = json.dumps({"version": SYNTHETIC_VERSION, **asdict(settings),
                                        "train_rows": SYNTHETIC_TRAIN_ROWS,

@@ -6,6 +6,7 @@ dropped silently. See ``raw/nl2tl/SOURCE.md`` for the raw fields.
 
 from __future__ import annotations
 
+import gzip
 import hashlib
 import json
 import re
@@ -95,7 +96,25 @@ class _RowError(AraError, ValueError):
 
 def read_jsonl(path: Path) -> list[dict]:
     """The rows of a raw JSON-lines file (blank lines skipped)."""
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    return _rows(path.read_text())
+
+
+def read_raw(raw_dir: Path, name: str) -> tuple[list[dict], str]:
+    """The rows of the vendored file ``name`` and the sha256 of its text.
+
+    The files are stored gzipped (``raw_dir/NAME.gz``) to keep the clone small; the hash
+    is of the uncompressed bytes, the one ``SOURCE.md`` lists, so a data version does not
+    depend on how the file is stored.
+    """
+    path = raw_dir / f"{name}.gz"
+    if not path.is_file():
+        raise FileNotFoundError(f"no vendored file {path}")
+    data = gzip.decompress(path.read_bytes())
+    return _rows(data.decode()), hashlib.sha256(data).hexdigest()
+
+
+def _rows(text: str) -> list[dict]:
+    return [json.loads(line) for line in text.splitlines() if line.strip()]
 
 
 def form_of(aps: Iterable[str]) -> str:

@@ -27,7 +27,7 @@ from ara.data.normalize import (
     RejectedRow,
     normalize_navi,
     normalize_timed,
-    read_jsonl,
+    read_raw,
 )
 from ara.data.splits import disjoint_split, given_split, overlap_stats, paper_split
 from ara.errors import ConfigError, DataVersionError, did_you_mean
@@ -94,17 +94,18 @@ def build_split(split: str, seed: int) -> tuple[dict[str, list[Record]], list[Re
         return ({"train": [], "test": suite_records(split)}, [],
                 {SUITES[split].name: sha256_file(SUITES[split])})
     if split == "timed":
-        files = ["lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"]
-        train, rej_train = normalize_timed(read_jsonl(RAW_DIR / files[0]), "nl2tl_timed_train")
-        test, rej_test = normalize_timed(read_jsonl(RAW_DIR / files[1]), "nl2tl_timed_dev")
+        (train_rows, train_hash), (dev_rows, dev_hash) = (
+            read_raw(RAW_DIR, "lifted_stl_train.jsonl"), read_raw(RAW_DIR, "lifted_stl_dev.jsonl"))
+        train, rej_train = normalize_timed(train_rows, "nl2tl_timed_train")
+        test, rej_test = normalize_timed(dev_rows, "nl2tl_timed_dev")
         parts, rejected = given_split(train, test), rej_train + rej_test
+        sources = {"lifted_stl_train.jsonl": train_hash, "lifted_stl_dev.jsonl": dev_hash}
     else:
-        files = ["navi.jsonl"]
-        rows = read_jsonl(RAW_DIR / files[0])
+        rows, navi_hash = read_raw(RAW_DIR, "navi.jsonl")
         records, rejected = normalize_navi(rows)
         parts = (paper_split(records, len(rows), seed) if split == "paper"
                  else disjoint_split(records, seed))
-    sources = {name: sha256_file(RAW_DIR / name) for name in files}
+        sources = {"navi.jsonl": navi_hash}
     if split == "timed":
         sources["timed_labels"] = TIMED_LABELS_VERSION
     return parts, rejected, sources

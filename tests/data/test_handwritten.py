@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import re
 
 import pytest
 
 from ara.data.handwritten import SUITE, SUITE2, SUITE3, SUITE4, SUITES, load_suite, suite_records
+from ara.data.normalize import read_raw
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
 from ara.grammars.spot_bridge import equivalent
@@ -57,9 +57,8 @@ def test_no_suite_sentence_occurs_in_any_training_source(suite):
     occurs in any vendored raw file."""
     _, entries = suite
     seen = set()
-    for path in RAW_DIR.glob("*.jsonl"):
-        for line in path.read_text().splitlines():
-            row = json.loads(line)
+    for path in RAW_DIR.glob("*.jsonl.gz"):
+        for row in read_raw(RAW_DIR, path.name.removesuffix(".gz"))[0]:
             for field in ("sentence", "logic_sentence"):
                 if row.get(field):
                     seen.add(_norm(" ".join(row[field])))

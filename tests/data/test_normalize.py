@@ -1,6 +1,5 @@
 """Raw NL2TL rows to records: operators, grounding, uids, rejected rows."""
 
-import hashlib
 import re
 
 from ara.data.normalize import (
@@ -10,7 +9,7 @@ from ara.data.normalize import (
     lifted_tokens_to_text,
     normalize_navi,
     normalize_timed,
-    read_jsonl,
+    read_raw,
 )
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
@@ -84,12 +83,13 @@ def test_helpers_tidy_sentences_and_names():
 
 
 def test_vendored_files_match_their_provenance_note():
-    """Tests that the raw files are the ones SOURCE.md lists, byte for byte."""
+    """Tests that the raw files, stored gzipped, are the ones SOURCE.md lists, byte for
+    byte once uncompressed."""
     note = (RAW_DIR / "SOURCE.md").read_text()
     listed = dict(re.findall(r"\| (\S+\.jsonl) \| [\d,]+ \| .*? \| ([0-9a-f]{64}) \|", note))
     assert sorted(listed) == ["lifted_stl_dev.jsonl", "lifted_stl_train.jsonl", "navi.jsonl"]
     for name, digest in listed.items():
-        assert hashlib.sha256((RAW_DIR / name).read_bytes()).hexdigest() == digest
+        assert read_raw(RAW_DIR, name)[1] == digest
 
 
 def test_timed_navi_style_rows_take_the_structure_of_their_grounded_formula():
@@ -118,13 +118,13 @@ def test_timed_signal_rows_keep_their_lifted_label():
 def test_timed_files_agree_with_navi_on_every_shared_sentence():
     """With the restored structure, the two NL2TL sources label every lifted sentence
     they share the same way (before, about half of the shared sentences disagreed)."""
-    navi, _ = normalize_navi(read_jsonl(RAW_DIR / "navi.jsonl"))
+    navi, _ = normalize_navi(read_raw(RAW_DIR, "navi.jsonl")[0])
     labels: dict[str, set[str]] = {}
     for r in navi:
         if r.form == "lifted":
             labels.setdefault(r.nl, set()).add(r.stl)
     for name in ("lifted_stl_train.jsonl", "lifted_stl_dev.jsonl"):
-        timed, rejected = normalize_timed(read_jsonl(RAW_DIR / name))
+        timed, rejected = normalize_timed(read_raw(RAW_DIR, name)[0])
         shared = [r for r in timed if r.nl in labels]
         assert len(shared) > 1000 and rejected == []
         assert [r for r in shared if r.stl not in labels[r.nl]] == []
