@@ -8,8 +8,8 @@ or the memory of a step), then ``ara train``'s recipe runs ``--steps`` steps on 
 the settings of the config that architecture ships with:
 
 * ``tiny``: the 2-layer test model, the CPU config's batch (a smoke run of the GPU path);
-* ``270m``: ``gemma3_270m_lora_cpu_compositional.yaml`` (what the shipped fine-tune's
-  540 steps would take on this GPU);
+* ``270m``: the first stage of ``gemma3_270m_nl2tl.yaml`` (what the shipped recipe's
+  steps take on this GPU);
 * ``12b``: ``gemma3_12b_lora_gpu.yaml`` (batch 16, bf16; what one GPU needs for it).
 
 Prints one table row per architecture: median seconds per step (first 3 steps are
@@ -45,8 +45,8 @@ ARCHS = {
                 num_attention_heads=16, num_key_value_heads=8, head_dim=256,
                 query_pre_attn_scalar=256, sliding_window=1024),
 }
-CONFIGS = {"tiny": "gemma3_270m_lora_cpu_compositional.yaml",
-           "270m": "gemma3_270m_lora_cpu_compositional.yaml",
+CONFIGS = {"tiny": "gemma3_270m_nl2tl.yaml",
+           "270m": "gemma3_270m_nl2tl.yaml",
            "12b": "gemma3_12b_lora_gpu.yaml"}
 
 
@@ -75,8 +75,12 @@ def run(arch: str, steps: int, tokenizer_dir: Path, scratch: Path) -> dict:
     from ara.data.store import prepare
     from ara.training.config import TrainConfig
     from ara.training.recipe import LoRAFinetuneRecipe
+    from ara.training.stages import StagedRecipe, is_staged
 
     shipped = yaml.safe_load((REPO / "training" / "configs" / CONFIGS[arch]).read_text())
+    if is_staged(shipped):  # a recipe: its first stage's run
+        recipe = StagedRecipe.from_dict(shipped)
+        shipped = recipe.train_config(recipe.stages[0]).to_dict()
     prepare(shipped["data"]["split"], shipped["data"]["seed"])
     model_dir = random_model(arch, tokenizer_dir, scratch / f"{arch}-model")
     config = TrainConfig.from_dict({**shipped, "base_model": str(model_dir),

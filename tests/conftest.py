@@ -91,7 +91,7 @@ def finetuned(embedded_model_path):
     from ara.eval.models import FINETUNED_LORA, make_backend
 
     if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (scripts/finetune_270m.sh)")
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (`ara train` rebuilds it)")
     return make_backend("finetuned")
 
 

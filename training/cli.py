@@ -28,11 +28,23 @@ def prepare_cmd(
 
 def train_cmd(
     config: Path = typer.Option(..., "--config",
-                                help="A run config, e.g. training/configs/*.yaml."),
-    max_steps: int = typer.Option(None, "--max-steps", help="Stop after N optimizer steps."),
-    resume: bool = typer.Option(False, "--resume", help="Continue from the newest checkpoint."),
+                                help="A run config, or a staged recipe (a config with "
+                                     "`stages:`), e.g. training/configs/gemma3_270m_nl2tl.yaml."),
+    max_steps: int = typer.Option(
+        None, "--max-steps",
+        help="Stop after N optimizer steps (in a recipe: each training stage, a smoke run)."),
+    resume: bool = typer.Option(
+        False, "--resume",
+        help="Continue a single run from its newest checkpoint (a recipe always goes on "
+             "where it stopped)."),
 ) -> None:
-    """LoRA fine-tuning (transformers + peft + accelerate) with the eval prompt format."""
+    """LoRA fine-tuning (transformers + peft + accelerate) with the eval prompt format.
+
+    A staged recipe runs its stages in order (train, soup, export), each into OUT/NAME;
+    rerun the same command to go on after an interruption: done stages are skipped, an
+    interrupted one resumes, and a stage whose settings changed is rebuilt with the
+    stages after it. OUT/recipe.json records each stage's wall time and peak memory.
+    """
     import json
 
     from ara.training.recipe import main
@@ -61,30 +73,10 @@ def soup_cmd(
     """
     import json
 
-    from ara.errors import ConfigError
-    from ara.training.soup import SoupPart, average_adapters, reduce_rank
+    from ara.training.soup import soup_runs
 
     with user_errors():
-        weights = weights or [1.0] * len(runs)
-        if len(weights) != len(runs):
-            raise ConfigError(f"{len(weights)} --weight values for {len(runs)} --run folders")
-        if len(runs) < 2 and rank is None:
-            raise ConfigError("a soup needs at least two --run folders (or one and --rank)")
-        for run in runs:
-            if not (run / "run.json").is_file():
-                raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")
-        # The first run's record (base model, data version) is what export needs; the
-        # soup's own parts say where the weights came from.
-        record = json.loads((runs[0] / "run.json").read_text())
-        adapter = out / "adapter"
-        if len(runs) > 1:
-            parts = [SoupPart(run / "adapter", w) for run, w in zip(runs, weights, strict=True)]
-            record["soup"] = average_adapters(parts, adapter)
-        if rank is not None:
-            record["reduced"] = reduce_rank(adapter if len(runs) > 1 else runs[0] / "adapter",
-                                            rank, adapter)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+        record = soup_runs(runs, weights, out, rank)
     typer.echo(json.dumps({k: record[k] for k in ("soup", "reduced") if k in record},
                           indent=2))
 
@@ -101,23 +93,8 @@ def export_cmd(
     import json
 
     from ara.cli_support import split_list
-    from ara.training.export import export_run, parity
+    from ara.training.export import export_checked
 
     with user_errors():
-        quants = split_list(quant)
-        outtype = "f32" if "f32" in quants else "f16"
-        manifest = export_run(run, quants, lora_gguf, outtype)
-        if parity_pairs:
-            from ara.data import load_split
-
-            saved = json.loads((run / "run.json").read_text())
-            config = saved["config"]
-            # The version the run trained on, which run.json records
-            records = load_split(config["data"]["split"], config["data"]["seed"],
-                                 version=saved["data"]["version"]).records(
-                "test", config["data"]["forms"][0])[:parity_pairs]
-            export = run / "export"
-            manifest["parity"] = parity(export / f"model-{outtype}.gguf", export / "merged-hf",
-                                        records)
-            (export / "export.json").write_text(json.dumps(manifest, indent=2) + "\n")
+        manifest = export_checked(run, split_list(quant), lora_gguf, parity_pairs)
     typer.echo(json.dumps(manifest, indent=2))

@@ -157,3 +157,26 @@ def parity(gguf: Path, hf_dir: Path, records, lora: Path | None = None,
     agree = sum(a == b for a, b in pairs)
     return {"pairs": len(pairs), "agree": agree, "agreement": agree / max(1, len(pairs)),
             "disagreements": [p for p in pairs if p[0] != p[1]][:5]}
+
+
+def export_checked(run_dir: Path, quants: tuple[str, ...] | list[str] = ("f16",),
+                   lora_gguf: bool = False, parity_pairs: int = 20) -> dict:
+    """:func:`export_run`, then the greedy parity of the GGUF and the merged HF model on
+    the first ``parity_pairs`` test pairs of the data version the run trained on (0: no
+    check); the manifest, with ``parity``, is ``run_dir/export/export.json``."""
+    quants = tuple(quants)
+    outtype = "f32" if "f32" in quants else "f16"
+    manifest = export_run(Path(run_dir), quants, lora_gguf, outtype)
+    if parity_pairs:
+        from ara.data import load_split
+
+        saved = json.loads((Path(run_dir) / "run.json").read_text())
+        config = saved["config"]
+        records = load_split(config["data"]["split"], config["data"]["seed"],
+                             version=saved["data"]["version"]).records(
+            "test", config["data"]["forms"][0])[:parity_pairs]
+        export = Path(run_dir) / "export"
+        manifest["parity"] = parity(export / f"model-{outtype}.gguf", export / "merged-hf",
+                                    records)
+        (export / "export.json").write_text(json.dumps(manifest, indent=2) + "\n")
+    return manifest

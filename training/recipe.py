@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 import torch
+import yaml
 from tqdm import tqdm
 
 from ara import __version__
@@ -360,11 +361,8 @@ def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
             "keep_checkpoints and eval_pairs may change), or train into another out folder")
 
 
-def main(config_path: str, max_steps: int | None = None, resume: bool = False) -> dict:
+def run_training(config: TrainConfig, resume: bool = False) -> dict:
     """Train, save the adapter, run the held-out check; returns a summary."""
-    config = TrainConfig.from_yaml(config_path)
-    if max_steps is not None:
-        config = TrainConfig.from_dict({**config.to_dict(), "max_steps": max_steps})
     recipe = LoRAFinetuneRecipe(config, resume)
     recipe.setup()
     losses = recipe.train()
@@ -377,3 +375,20 @@ def main(config_path: str, max_steps: int | None = None, resume: bool = False) -
             summary["heldout"] = recipe.heldout_check()
     recipe.accelerator.wait_for_everyone()
     return summary
+
+
+def main(config_path: str, max_steps: int | None = None, resume: bool = False) -> dict:
+    """``ara train --config``: one run, or every stage of a staged recipe not yet done."""
+    from ara.training.stages import StagedRecipe, is_staged, run_recipe
+
+    path = Path(config_path)
+    if not path.is_file():
+        raise ConfigError(f"config file not found: {path}")
+    data = yaml.safe_load(path.read_text()) or {}
+    if is_staged(data):
+        # A recipe resumes by itself: each rerun goes on where the last one stopped.
+        return run_recipe(StagedRecipe.from_dict(data), max_steps)
+    config = TrainConfig.from_dict(data)
+    if max_steps is not None:
+        config = TrainConfig.from_dict({**config.to_dict(), "max_steps": max_steps})
+    return run_training(config, resume)

@@ -190,3 +190,33 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
     _write(out, reduced, dict(config, r=rank, lora_alpha=alpha), adapter,
            TOKENIZER_FILES + ("soup.json",), "reduced.json", record)
     return record
+
+
+def soup_runs(runs: list[Path], weights: list[float] | None, out: Path,
+              rank: int | None = None) -> dict:
+    """Average finished ``ara train`` runs into the run folder ``out`` (``adapter/``,
+    ``run.json``), optionally reduced to ``rank``; one run is enough with ``rank``.
+
+    Returns the run record written to ``out/run.json``: the first run's (base model and
+    data version, which export needs) with the soup's own parts under ``soup`` and
+    ``reduced``.
+    """
+    weights = list(weights or [1.0] * len(runs))
+    if len(weights) != len(runs):
+        raise ConfigError(f"{len(weights)} weights for {len(runs)} runs: one per run, in order")
+    if len(runs) < 2 and rank is None:
+        raise ConfigError("a soup needs at least two runs (or one and a rank to reduce it to)")
+    for run in runs:
+        if not (Path(run) / "run.json").is_file():
+            raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")
+    record = json.loads((Path(runs[0]) / "run.json").read_text())
+    adapter = Path(out) / "adapter"
+    if len(runs) > 1:
+        parts = [SoupPart(Path(run) / "adapter", w) for run, w in zip(runs, weights, strict=True)]
+        record["soup"] = average_adapters(parts, adapter)
+    if rank is not None:
+        source = adapter if len(runs) > 1 else Path(runs[0]) / "adapter"
+        record["reduced"] = reduce_rank(source, rank, adapter)
+    Path(out).mkdir(parents=True, exist_ok=True)
+    (Path(out) / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    return record

@@ -115,7 +115,7 @@ def shipped_translator():
     from ara.eval.translator import Translator
 
     if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (scripts/finetune_270m.sh)")
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (`ara train` rebuilds it)")
     return Translator(make_backend("finetuned"))
 
 

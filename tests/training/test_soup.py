@@ -125,7 +125,7 @@ def test_ara_soup_makes_a_run_folder_that_export_can_read(tmp_path):
     assert (tmp_path / "soup" / "adapter" / "adapter_model.safetensors").is_file()
 
     wrong = CliRunner().invoke(app, args + ["--weight", "1", "--out", str(tmp_path / "x")])
-    assert wrong.exit_code != 0 and "1 --weight values for 2 --run folders" in wrong.output
+    assert wrong.exit_code != 0 and "1 weights for 2 runs" in wrong.output
     bare = CliRunner().invoke(app, ["soup", "--run", str(runs[0]), "--run", str(tmp_path),
                                     "--out", str(tmp_path / "y")])
     assert bare.exit_code != 0 and "no run.json" in bare.output
@@ -137,7 +137,7 @@ def test_ara_soup_makes_a_run_folder_that_export_can_read(tmp_path):
     assert record["soup"]["rank"] == 8 and record["reduced"]["rank"] == 5
     one = ["soup", "--run", str(tmp_path / "soup5"), "--out", str(tmp_path / "soup2")]
     alone = CliRunner().invoke(app, one)
-    assert alone.exit_code != 0 and "at least two --run folders (or one and --rank)" in alone.output
+    assert alone.exit_code != 0 and "at least two runs (or one and a rank" in alone.output
     done = CliRunner().invoke(app, one + ["--rank", "2"])
     assert done.exit_code == 0, done.output
     record = json.loads((tmp_path / "soup2" / "run.json").read_text())

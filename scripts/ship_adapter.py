@@ -1,0 +1,93 @@
+"""Ship an exported adapter as a `--model` of the toolkit, after checking what users run.
+
+    .venv/bin/python scripts/ship_adapter.py runs/recipe/gemma3-270m-nl2tl/export
+    .venv/bin/python scripts/ship_adapter.py runs/train/gemma3-270m-lora \\
+        --name gemma3-270m-nl2tl-paper-lora.gguf --split paper
+
+EXPORT is the recipe's export stage, or a run folder that `ara export --lora-gguf` wrote
+into (its `export/`). The adapter is copied into `eval/models/NAME` beside a record of
+what produced it (the run, the export with its parity, the held-out check) and the parity
+of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
+merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
+`--min-agreement` nothing is shipped. Compare the candidate on the blind sets
+(`scripts/eval_generalization.sh lora:EXPORT/lora.gguf NAME`, `ara eval diff`) first.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+from pathlib import Path
+
+from ara.errors import ConfigError
+
+
+def export_folders(path: Path) -> tuple[Path, Path]:
+    """(the training run's record folder, the export folder) of ``path``."""
+    export = path / "export" if (path / "export" / "lora.gguf").is_file() else path
+    run = path if (path / "run.json").is_file() else export
+    for need in (export / "lora.gguf", export / "export.json", export / "merged-hf",
+                 run / "run.json"):
+        if not need.exists():
+            raise ConfigError(f"{path}: no {need.name}; export the run first "
+                              "(`ara export --run RUN --quant f16 --lora-gguf`)")
+    return run, export
+
+
+def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20) -> dict:
+    from ara.data import load_or_prepare
+    from ara.eval.llama_check import default_model_path
+    from ara.eval.models import SHIPPED
+    from ara.provenance import sha256_file
+    from ara.training.export import parity
+
+    run, export = export_folders(path)
+    data = load_or_prepare(split, 0)
+    records = data.records("test", "lifted")[:pairs] + data.records("test", "grounded")[:pairs]
+    checked = parity(Path(default_model_path()), export / "merged-hf", records,
+                     lora=export / "lora.gguf")
+    if checked["agreement"] < min_agreement:
+        raise ConfigError(f"the Q4_K_M base with this adapter agrees with the merged model on "
+                          f"{checked['agree']} of {checked['pairs']} pairs, below "
+                          f"{min_agreement:.0%}: not shipped")
+    target = SHIPPED / name
+    shutil.copyfile(export / "lora.gguf", target)
+    heldout = run / "heldout.json"
+    manifest = {"file": name, "sha256": sha256_file(target),
+                "run": json.loads((run / "run.json").read_text()),
+                "export": json.loads((export / "export.json").read_text()),
+                # A soup was never trained as a whole: no held-out check of its own.
+                "heldout": json.loads(heldout.read_text()) if heldout.is_file() else None,
+                "shipped_parity": {
+                    "what": "embedded Q4_K_M GGUF + this adapter (llama.cpp) vs the merged HF "
+                            f"model (transformers, fp32), greedy, zero-shot, unconstrained; "
+                            f"{pairs} lifted + {pairs} grounded {split} test pairs",
+                    **checked}}
+    target.with_suffix(".json").write_text(json.dumps(manifest, indent=2) + "\n")
+    return manifest
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("export", type=Path, help="the export stage, or an exported run folder")
+    parser.add_argument("--name", default="gemma3-270m-nl2tl-lora.gguf",
+                        help="file name in eval/models/ (default: the --model finetuned one)")
+    parser.add_argument("--split", default="compositional",
+                        help="split whose test pairs the parity check reads")
+    parser.add_argument("--min-agreement", type=float, default=0.9,
+                        help="ship only when at least this share of greedy answers agree")
+    args = parser.parse_args(argv)
+    try:
+        manifest = ship(args.export, args.name, args.split, args.min_agreement)
+    except ConfigError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    print(json.dumps({k: manifest[k] for k in ("file", "sha256")}
+                     | {"parity": manifest["shipped_parity"]["agreement"]}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

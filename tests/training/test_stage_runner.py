@@ -1,0 +1,120 @@
+"""The staged recipe (`ara train --config` with `stages:`): one command from the base model
+to a soup, which a rerun continues and an edit rebuilds from the edited stage on."""
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from ara.errors import ConfigError
+from ara.training.stages import StagedRecipe, run_recipe
+
+SHIPPED_RECIPE = Path(__file__).parents[2] / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
+
+
+@pytest.fixture(scope="module")
+def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
+    """A 2-layer, 32-wide Gemma 3 with random weights and the real 262k tokenizer."""
+    from ara.training.tiny import build_tiny_gemma
+
+    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
+
+
+def tiny_recipe(model_dir, out, refine_b_seed=2) -> dict:
+    """The shipped recipe's shape (a start, two refinements from it, their soup at the
+    start's rank) on a tiny model and a few steps."""
+    return {
+        "out": str(out),
+        "defaults": {"base_model": model_dir, "seed": 0, "checkpoint_every": 1,
+                     "keep_checkpoints": 1, "eval_pairs": 0,
+                     "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
+                     "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0},
+                     "data": {"forms": ["lifted"], "limit": 8}},
+        "stages": [
+            {"name": "start", "train": {"max_steps": 2}},
+            {"name": "refine-a", "from": "start", "train": {"seed": 1, "max_steps": 1}},
+            {"name": "refine-b", "from": "start",
+             "train": {"seed": refine_b_seed, "max_steps": 1}},
+            {"name": "soup", "soup": ["refine-a", "refine-b"], "rank": 4},
+        ]}
+
+
+def test_the_shipped_recipe_reads_the_base_model_and_registered_data_alone():
+    """Tests the config `ara train` rebuilds `--model finetuned` with: every training stage
+    starts from the embedded base model or an earlier stage's adapter under its own
+    `out`, on the data version this release registers, and it ends in an export."""
+    recipe = StagedRecipe.from_dict(yaml.safe_load(SHIPPED_RECIPE.read_text()))
+    assert [s.name for s in recipe.stages] == ["start", "refine-a", "refine-b", "soup",
+                                                "export"]
+    for stage in recipe.stages:
+        if stage.kind == "train":
+            config = recipe.train_config(stage)
+            assert config.base_model == "default" and config.data.version is None
+            assert config.init_adapter is None or config.init_adapter.startswith(
+                str(recipe.out))
+    assert recipe.stages[-1].kind == "export" and recipe.stages[-1].inputs == ("soup",)
+
+
+@pytest.mark.parametrize("stages, message", [
+    ([{"name": "a", "train": {}, "from": "b"}, {"name": "b", "train": {}}],
+     "reads 'b', which is not a stage before it"),
+    ([{"name": "a", "train": {"out": "elsewhere"}}], "out is set by the recipe"),
+    ([{"name": "a", "train": {}}, {"name": "a", "train": {}}], "two stages are named a"),
+    ([{"name": "a", "train": {}}, {"name": "s", "soup": ["a"]}], "a soup needs two stages"),
+    ([{"name": "a", "train": {}}, {"name": "e", "export": "a"}, {"name": "f", "export": "e"}],
+     "reads e, an export"),
+    ([{"name": "a", "train": {}, "soup": ["a"]}], "exactly one of train, soup, export"),
+    ([{"name": "a", "train": {"optim": {"lr": -1}}}], "optim values out of range"),
+    ([{"name": "a", "train": {"lora": {"rank": 4}}}], "unknown key lora.rank"),
+])
+def test_a_recipe_that_cannot_run_is_refused_before_anything_trains(stages, message):
+    with pytest.raises(ConfigError, match=message):
+        StagedRecipe.from_dict({"out": "runs/x", "stages": stages})
+
+
+def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
+        tiny_gemma_dir, paper_split, tmp_path):
+    """Tests the runner end to end on a tiny Gemma 3: interrupted between stages, a rerun
+    skips what is done; an edited stage is run again with every stage after it that
+    reads it, and nothing else; each stage's wall time and memory are recorded."""
+    out = tmp_path / "recipe"
+    recipe = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out))
+
+    def stop_at_refine_a(line):
+        if line.startswith("stage refine-a: started"):
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_recipe(recipe, log=stop_at_refine_a)
+    assert json.loads((out / "start" / "stage.json").read_text())["done"] is True
+    assert not (out / "refine-a").exists()
+
+    lines: list[str] = []
+    record = run_recipe(recipe, log=lines.append)
+    assert lines[0] == "stage start: done, skipped"
+    assert [line for line in lines if "started" in line] == [
+        "stage refine-a: started (train)", "stage refine-b: started (train)",
+        "stage soup: started (soup)"]
+    stages = record["stages"]
+    assert set(stages) == {"start", "refine-a", "refine-b", "soup"}
+    assert all(s["wall_s"] > 0 and s["peak_rss_mb"] > 0 for s in stages.values())
+    assert stages["refine-a"]["result"]["steps"] == 1
+    soup = json.loads((out / "soup" / "run.json").read_text())
+    assert soup["soup"]["rank"] == 8 and soup["reduced"]["rank"] == 4
+    warm = json.loads((out / "refine-b" / "run.json").read_text())["init_adapter"]
+    assert warm["path"] == str(out / "start" / "adapter")
+    assert json.loads((out / "recipe.json").read_text()) == record
+
+    lines.clear()
+    run_recipe(recipe, log=lines.append)
+    assert all(line.endswith("done, skipped") for line in lines) and len(lines) == 4
+
+    soup_before = (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes()
+    edited = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out, refine_b_seed=3))
+    lines.clear()
+    run_recipe(edited, log=lines.append)
+    assert [line for line in lines if "skipped" in line] == [
+        "stage start: done, skipped", "stage refine-a: done, skipped"]
+    assert "stage refine-b: started (train)" in lines and "stage soup: started (soup)" in lines
+    assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before

@@ -1,0 +1,293 @@
+"""A staged recipe: a translator rebuilt from the base model by one command.
+
+    ara train --config training/configs/gemma3_270m_nl2tl.yaml     # rerun to continue
+
+A recipe config names an ``out`` folder, the ``defaults`` every training stage starts
+from (the keys of a single-run config, :class:`~ara.training.config.TrainConfig`) and
+its ``stages``, in order, each one of:
+
+- ``train: {...}``: a LoRA run, its settings laid over ``defaults``; with
+  ``from: STAGE`` it warm-starts from that stage's adapter;
+- ``soup: [STAGE, ...]``: the average of those stages' adapters (``weights``, optional),
+  reduced to ``rank`` when given (:func:`~ara.training.soup.soup_runs`);
+- ``export: STAGE``: that stage's adapter as a GGUF LoRA for llama.cpp, with the greedy
+  parity check of the GGUF against transformers (:func:`~ara.training.export.export_checked`).
+
+Each stage writes ``OUT/NAME/`` and reads only the folders of the stages it names, so the
+recipe needs nothing but the base model and the registered data. A stage is done when
+``OUT/NAME/stage.json`` holds ``done: true`` and the fingerprint of its settings and of
+its inputs' fingerprints. A rerun skips done stages, resumes an interrupted training
+stage from its newest checkpoint and runs again, from scratch, a stage whose settings or
+inputs changed (its old folder removed), so that every stage after an edited one is
+rebuilt too. ``OUT/recipe.json`` records each stage's wall time and memory.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import resource
+import shutil
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ara.errors import ConfigError, did_you_mean
+from ara.training.config import TrainConfig
+
+KINDS = ("train", "soup", "export")
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One step of a recipe.
+
+    Args:
+        name: Folder name under the recipe's ``out``; letters, digits, ``-`` and ``_``.
+        kind: ``train``, ``soup`` or ``export``.
+        settings: For ``train``, the run's config laid over the recipe's ``defaults``
+            (``out`` and ``init_adapter`` are the recipe's to set); for ``soup``,
+            ``weights`` and ``rank``; for ``export``, ``parity`` (test pairs, default 20).
+        inputs: The stages it reads: a training stage's ``from``, a soup's parts, what
+            an export exports.
+    """
+
+    name: str
+    kind: str
+    settings: dict = field(default_factory=dict)
+    inputs: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.name or not all(c.isalnum() or c in "-_" for c in self.name):
+            raise ConfigError(f"stage name {self.name!r}: use letters, digits, '-' and '_'")
+        if self.kind not in KINDS:
+            raise ConfigError(f"stage {self.name}: kind {self.kind!r} is not one of {KINDS}")
+        if self.kind == "soup" and len(self.inputs) < 2 and self.settings.get("rank") is None:
+            raise ConfigError(f"stage {self.name}: a soup needs two stages, or one and a rank")
+        if self.kind == "export" and len(self.inputs) != 1:
+            raise ConfigError(f"stage {self.name}: export names exactly one stage")
+
+
+@dataclass(frozen=True)
+class StagedRecipe:
+    """A recipe's stages and where they write.
+
+    Args:
+        out: The recipe's folder; stage ``NAME`` writes ``out/NAME``.
+        defaults: Settings every training stage starts from.
+        stages: In the order they run; each reads only stages before it.
+    """
+
+    out: Path
+    defaults: dict
+    stages: tuple[Stage, ...]
+
+    def __post_init__(self) -> None:
+        seen: dict[str, Stage] = {}
+        for stage in self.stages:
+            if stage.name in seen:
+                raise ConfigError(f"two stages are named {stage.name}")
+            for name in stage.inputs:
+                if name not in seen:
+                    raise ConfigError(f"stage {stage.name} reads {name!r}, which is not a "
+                                      f"stage before it. {did_you_mean(name, seen)}")
+                if seen[name].kind == "export":
+                    raise ConfigError(f"stage {stage.name} reads {name}, an export: name the "
+                                      "stage whose adapter it exported")
+            seen[stage.name] = stage
+        if not self.stages:
+            raise ConfigError("a recipe needs at least one stage")
+        for stage in self.stages:
+            if stage.kind == "train":
+                self.train_config(stage)  # each stage's run config checks its own ranges
+
+    @classmethod
+    def from_dict(cls, data: dict) -> StagedRecipe:
+        known = {"out", "defaults", "stages"}
+        for key in data:
+            if key not in known:
+                raise ConfigError(f"unknown key {key}. {did_you_mean(key, known)}")
+        if "out" not in data or not isinstance(data.get("stages"), list):
+            raise ConfigError("a recipe needs `out` and a list of `stages`")
+        return cls(Path(data["out"]), dict(data.get("defaults") or {}),
+                   tuple(_stage(item) for item in data["stages"]))
+
+    def folder(self, name: str) -> Path:
+        return self.out / name
+
+    def train_config(self, stage: Stage) -> TrainConfig:
+        """The single-run config of a training stage: ``defaults`` with the stage's
+        settings laid over them (sections merged key by key), writing into its folder."""
+        for key in ("out", "init_adapter"):
+            if key in stage.settings:
+                raise ConfigError(f"stage {stage.name}: {key} is set by the recipe "
+                                  "(the stage's folder, and `from:`)")
+        merged = _merged(self.defaults, stage.settings)
+        merged["out"] = str(self.folder(stage.name))
+        if stage.inputs:
+            merged["init_adapter"] = str(self.folder(stage.inputs[0]) / "adapter")
+        return TrainConfig.from_dict(merged)
+
+    def fingerprints(self) -> dict[str, str]:
+        """Each stage's identity: its kind, settings and its inputs' fingerprints."""
+        prints: dict[str, str] = {}
+        for stage in self.stages:
+            settings = (self.train_config(stage).to_dict() if stage.kind == "train"
+                        else stage.settings)
+            blob = json.dumps({"kind": stage.kind, "settings": settings,
+                               "inputs": [prints[name] for name in stage.inputs]},
+                              sort_keys=True)
+            prints[stage.name] = hashlib.sha256(blob.encode()).hexdigest()[:16]
+        return prints
+
+
+def _stage(item: Any) -> Stage:
+    if not isinstance(item, dict) or "name" not in item:
+        raise ConfigError(f"each stage is a mapping with a name, got {item!r}")
+    item = dict(item)
+    name = item.pop("name")
+    kinds = [k for k in KINDS if k in item]
+    if len(kinds) != 1:
+        raise ConfigError(f"stage {name}: give exactly one of {', '.join(KINDS)}")
+    kind = kinds[0]
+    if kind == "train":
+        settings, source = item.pop("train") or {}, item.pop("from", None)
+        inputs = (source,) if source else ()
+    elif kind == "soup":
+        inputs = tuple(item.pop("soup") or ())
+        settings = {k: item.pop(k) for k in ("weights", "rank") if k in item}
+    else:
+        inputs = (item.pop("export"),)
+        settings = {k: item.pop(k) for k in ("parity",) if k in item}
+    if item:
+        raise ConfigError(f"stage {name}: unknown keys {sorted(item)} for a {kind} stage")
+    if not isinstance(settings, dict):
+        raise ConfigError(f"stage {name}: train settings must be a mapping")
+    return Stage(name, kind, settings, inputs)
+
+
+def _merged(base: dict, over: dict) -> dict:
+    out = dict(base)
+    for key, value in over.items():
+        out[key] = (_merged(out[key], value) if isinstance(value, dict)
+                    and isinstance(out.get(key), dict) else value)
+    return out
+
+
+def is_staged(data: dict) -> bool:
+    """Whether a config file's contents are a staged recipe rather than a single run."""
+    return isinstance(data, dict) and "stages" in data
+
+
+# -- running ----------------------------------------------------------------------------
+
+def _state(folder: Path) -> dict | None:
+    path = folder / "stage.json"
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def _write_state(folder: Path, state: dict) -> None:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "stage.json").write_text(json.dumps(state, indent=2, sort_keys=True) + "\n")
+
+
+def _peak_memory() -> dict:
+    """The process's resident high-water mark so far (MB), and the GPU's since the last
+    reset where there is one."""
+    rss_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    peak = {"peak_rss_mb": round(rss_kb / (1024 if sys.platform != "darwin" else 1024**2), 1)}
+    import torch
+
+    if torch.cuda.is_available():
+        peak["peak_cuda_mb"] = round(torch.cuda.max_memory_allocated() / 2**20, 1)
+        torch.cuda.reset_peak_memory_stats()
+    return peak
+
+
+def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
+               max_steps: int | None) -> dict:
+    folder = recipe.folder(stage.name)
+    if stage.kind == "train":
+        from ara.training.recipe import run_training
+
+        config = recipe.train_config(stage)
+        if max_steps is not None:
+            config = TrainConfig.from_dict({**config.to_dict(), "max_steps": max_steps})
+        return run_training(config, resume)
+    if stage.kind == "soup":
+        from ara.training.soup import soup_runs
+
+        record = soup_runs([recipe.folder(name) for name in stage.inputs],
+                           stage.settings.get("weights"), folder, stage.settings.get("rank"))
+        return {k: record[k] for k in ("soup", "reduced") if k in record}
+    from ara.training.export import export_checked
+
+    source = recipe.folder(stage.inputs[0])
+    manifest = export_checked(source, ("f16",), lora_gguf=True,
+                              parity_pairs=stage.settings.get("parity", 20))
+    # The export lives in its own stage folder, so that rerunning it leaves the
+    # adapter it read alone.
+    if folder.exists():
+        shutil.rmtree(folder)
+    shutil.move(str(source / "export"), str(folder))
+    # With the record of the run it exports, the folder is all that shipping needs.
+    shutil.copyfile(source / "run.json", folder / "run.json")
+    return {"files": manifest["files"], "parity": manifest.get("parity")}
+
+
+def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) -> dict:
+    """Run the stages that are not done; returns the recipe's record (``recipe.json``).
+
+    Args:
+        recipe: The stages.
+        max_steps: Cap every training stage at this many steps (a smoke run); the cap is
+            part of each stage's fingerprint, so a later full run starts them again.
+        log: Where a line per stage goes.
+    """
+    prints = recipe.fingerprints()
+    if max_steps is not None:
+        prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}
+    record_path = recipe.out / "recipe.json"
+    record = json.loads(record_path.read_text()) if record_path.is_file() else {}
+    record.setdefault("stages", {})
+    ran: set[str] = set()
+    for stage in recipe.stages:
+        folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
+        same = bool(state and state.get("fingerprint") == prints[stage.name]
+                    and not ran.intersection(stage.inputs))
+        if same and state.get("done"):
+            log(f"stage {stage.name}: done, skipped")
+            continue
+        resume = same and stage.kind == "train" and (folder / "run.json").is_file()
+        if folder.exists() and not resume:
+            # Made with other settings or from other inputs: it would mix two recipes.
+            shutil.rmtree(folder)
+            record["stages"].pop(stage.name, None)
+        log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")
+        before = {"wall_s": state.get("wall_s", 0.0), "sessions": state.get("sessions", 0)} \
+            if resume else {"wall_s": 0.0, "sessions": 0}
+        head = {"name": stage.name, "kind": stage.kind, "inputs": list(stage.inputs),
+                "fingerprint": prints[stage.name]}
+        _write_state(folder, {**head, **before, "done": False})
+        start = time.perf_counter()
+        try:
+            result = _run_stage(recipe, stage, resume, max_steps)
+        except BaseException:
+            # An interrupted stage keeps the time it took, which its resumption adds to.
+            if folder.exists():
+                _write_state(folder, {**head, "done": False, "sessions": before["sessions"] + 1,
+                                      "wall_s": round(before["wall_s"] + time.perf_counter()
+                                                      - start, 1)})
+            raise
+        wall = time.perf_counter() - start
+        entry = {**head, "wall_s": round(before["wall_s"] + wall, 1),
+                 "sessions": before["sessions"] + 1, **_peak_memory(), "result": result}
+        _write_state(recipe.folder(stage.name), {**entry, "done": True})
+        record["stages"][stage.name] = entry
+        ran.add(stage.name)
+        record_path.parent.mkdir(parents=True, exist_ok=True)
+        record_path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+        log(f"stage {stage.name}: done in {wall:.0f} s")
+    return record
