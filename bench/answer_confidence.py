@@ -1,14 +1,14 @@
 """How well the model's probability of its own answer tells right answers from wrong.
 
     .venv/bin/python bench/answer_confidence.py \
-        --runs 'docs/results/generalization/soup-v16v17-270m/*' --dev 'compositional-*' \
-        [--model finetuned] [--out docs/results/answer-confidence.json]
+        --runs 'runs/generalization/soup-v16v17-270m/*' --dev 'compositional-*' \
+        [--model finetuned] [--out runs/bench/answer-confidence.json]
     .venv/bin/python bench/answer_confidence.py \
-        --runs 'docs/results/generalization/soup-v16v17-270m/[ht]*' --resample 8 \
-        --out docs/results/answer-confidence-resampled.json
+        --runs 'runs/generalization/soup-v16v17-270m/[ht]*' --resample 8 \
+        --out runs/bench/answer-confidence-resampled.json
     .venv/bin/python bench/answer_confidence.py \
-        --runs 'docs/results/generalization/soup-v16v17-270m/[ht]*' --readings 3 \
-        --out docs/results/answer-confidence-readings.json
+        --runs 'runs/generalization/soup-v16v17-270m/[ht]*' --readings 3 \
+        --out runs/bench/answer-confidence-readings.json
 
 Scores every zero-shot constrained (C) answer in the run folders with ``--model`` (the
 model that gave them: the bench refuses folders run with another), judged right or
@@ -141,7 +141,7 @@ def main() -> None:
                         help="Translate flagged answers again with repair (ara translate's "
                              "default) and judge the winner and up to K other readings.")
     parser.add_argument("--spot-timeout", type=float, default=5.0)
-    parser.add_argument("--out", type=Path, default=Path("docs/results/answer-confidence.json"))
+    parser.add_argument("--out", type=Path, default=Path("runs/bench/answer-confidence.json"))
     args = parser.parse_args()
     folders = sorted(Path(p) for p in glob.glob(args.runs) if Path(p, "samples.jsonl").is_file())
     if not folders:

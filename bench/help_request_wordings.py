@@ -4,7 +4,7 @@ protocol's worked examples and repaired as a helper repairs it (as `ara translat
 does), each formula judged by Spot against the template's pick-before-place spec.
 
     .venv/bin/python bench/help_request_wordings.py [--model finetuned] [--sites 5]
-        [--out docs/results/help-request-wordings.json]
+        [--out runs/bench/help-request-wordings.json]
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="finetuned")
     parser.add_argument("--sites", type=int, default=5, help="Free cells drawn (seed 0).")
-    parser.add_argument("--out", type=Path, default=Path("docs/results/help-request-wordings.json"))
+    parser.add_argument("--out", type=Path, default=Path("runs/bench/help-request-wordings.json"))
     args = parser.parse_args()
     world = GridWorld.paper()
     free = list(world.free_cells)

@@ -21,10 +21,10 @@ again, and judges with Spot, side by side:
   that leave out least (``--repair-by samples+edits``, the default).
 
     .venv/bin/python bench/repair_strategies.py \\
-        (--runs 'docs/results/generalization/soup-v16v17-repair8-270m/*'
+        (--runs 'runs/generalization/soup-v16v17-repair8-270m/*'
          | --split compositional --form lifted --limit 200 --exclude 'RUN_DIRS/*') \\
         [--model finetuned] [--samples 8] [--spot-timeout 10]
-        [--strategies greedy,samples,edits] [--out docs/results/repair-strategies.json]
+        [--strategies greedy,samples,edits] [--out runs/bench/repair-strategies.json]
 """
 
 from __future__ import annotations
@@ -128,7 +128,7 @@ def main() -> None:
                              "counts as different) and against the reference.")
     parser.add_argument("--strategies", default=",".join(STRATEGIES),
                         help=f"Comma-separated, of {', '.join(STRATEGIES)}.")
-    parser.add_argument("--out", type=Path, default=Path("docs/results/repair-strategies.json"))
+    parser.add_argument("--out", type=Path, default=Path("runs/bench/repair-strategies.json"))
     args = parser.parse_args()
     strategies = tuple(args.strategies.split(","))
     if unknown := set(strategies) - set(STRATEGIES):

@@ -2,7 +2,7 @@
 time per formula on the hand-written suite (never trained on).
 
     .venv/bin/python bench/self_consistency.py [--model finetuned] [--samples 5]
-        [--temperature 0.7] [--out docs/results/self-consistency.json]
+        [--temperature 0.7] [--out runs/bench/self-consistency.json]
 
 Zero-shot for fine-tuned adapters (5 worked examples otherwise), under the grammar.
 The greedy answer is the vote's first answer, so both columns come from the same
@@ -36,7 +36,7 @@ def main() -> None:
     parser.add_argument("--temperature", type=float, default=0.7)
     parser.add_argument("--limit", type=int, default=None,
                         help="Instructions per form, sampled with seed 0 (default: all).")
-    parser.add_argument("--out", type=Path, default=Path("docs/results/self-consistency.json"))
+    parser.add_argument("--out", type=Path, default=Path("runs/bench/self-consistency.json"))
     args = parser.parse_args()
     translator = Translator(make_backend(args.model))
     k = default_shots(args.model)
@@ -68,6 +68,7 @@ def main() -> None:
           f"| {vote_ms:.0f} |")
     print(f"\n{n} hand-written instructions, model {translator.backend.model_id}; "
           f"vote/greedy time ratio {vote_ms / greedy_ms:.1f}")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps({
         "date": date.today().isoformat(), "machine": platform.platform(),
         "model": translator.backend.model_id, "samples": args.samples,

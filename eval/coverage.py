@@ -5,7 +5,8 @@ for (nested temporal operators, an order).
 A translation that never uses a proposition the user listed, or a number the sentence
 states as a bound, is wrong whatever else it says: "reach the dock within 250 steps"
 has to put 250 somewhere. On the shipped fine-tune's held-out sets nearly every answer
-with such a gap was wrong (docs/model-card.md), so a gap is a cheap, precise signal to draw more answers (:func:`ara.eval.consistency.translate_repaired`).
+with such a gap was wrong (docs/model-card.md), so a gap is a cheap, precise signal to
+draw more answers (:func:`ara.eval.consistency.translate_repaired`).
 
 The converse is checked for the one slip that needs words to be right: an ``F`` and a
 ``G`` nested (:mod:`ara.grammars.nesting`). ``G(F(a))`` says "a again and again" and

@@ -1,6 +1,6 @@
 """Base vs fine-tuned Gemma 3 270M, from the samples of the README's evaluation runs.
 
-    .venv/bin/python scripts/compare_models.py [--results docs/results]
+    .venv/bin/python scripts/compare_models.py [--results runs]
 
 For each split, variant and shot count: accuracy and validity over *all* test pairs (an
 invalid or undecided answer counts as wrong), averaged over reruns. The runs are the
@@ -39,7 +39,7 @@ def cells(folder: Path) -> dict[tuple[str, int], dict]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--results", type=Path, default=Path("docs/results"))
+    parser.add_argument("--results", type=Path, default=Path("runs"))
     args = parser.parse_args()
     print("| split | variant | shots | " + " | ".join(RUNS) + " |")
     print("|---|---|---:|" + "---:|" * len(RUNS))

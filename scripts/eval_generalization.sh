@@ -4,7 +4,7 @@
 #   scripts/eval_generalization.sh MODEL NAME [SET ...]
 #
 # MODEL is an `ara --model` value (finetuned, finetuned-paper, default, lora:FILE.gguf);
-# NAME names the results folder docs/results/generalization/NAME/<set>-<form>/. SETs
+# NAME names the results folder runs/generalization/NAME/<set>-<form>/. SETs
 # (default: all): handwritten (the hand-written suite, all 164), handwritten2 (the second
 # suite, all 109, never read to guide data), handwritten3 (the third, all 65, written
 # after repair's word checks and never read to guide anything), handwritten4 (the fourth,
@@ -26,7 +26,7 @@ name=${2:?usage: eval_generalization.sh MODEL NAME [SET ...]}
 shift 2
 sets=${*:-handwritten handwritten2 handwritten3 handwritten4 compositional timed paper disjoint}
 variants=${VARIANTS:-none,C,F+C}
-out=docs/results/generalization/$name
+out=runs/generalization/$name
 
 run() {  # SPLIT FORM LIMIT [VARIANTS]
   .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \

@@ -1,7 +1,7 @@
 """The generalization table: each model on each evaluation set, from the runs that
 ``scripts/eval_generalization.sh`` wrote.
 
-    .venv/bin/python scripts/generalization_table.py [--results docs/results/generalization]
+    .venv/bin/python scripts/generalization_table.py [--results runs/generalization]
 
     .venv/bin/python scripts/generalization_table.py --test compositional=2cc898a81b54
 
@@ -229,7 +229,7 @@ def markdown(table: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--results", type=Path, default=Path("docs/results/generalization"))
+    parser.add_argument("--results", type=Path, default=Path("runs/generalization"))
     parser.add_argument("--test", action="append", default=[], metavar="SPLIT=VERSION",
                         help="compare on this prepared version of a split's test side "
                              "(default: the registered one); repeatable")

@@ -2,7 +2,7 @@
 whether the two formulas are the same.
 
     .venv/bin/python scripts/round_trip.py [--model finetuned] [--limit 100]
-        [--out docs/results/round-trip.json]
+        [--out runs/bench/round-trip.json]
 
 Formulas: the hand-written suite's references and the compositional test side's
 (lifted and grounded, ``--limit`` of each, seed 0). ``ara stl explain`` reads a formula
@@ -34,7 +34,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="finetuned")
     parser.add_argument("--limit", type=int, default=100, help="Formulas per source and form.")
-    parser.add_argument("--out", type=Path, default=Path("docs/results/round-trip.json"))
+    parser.add_argument("--out", type=Path, default=Path("runs/bench/round-trip.json"))
     args = parser.parse_args()
     sources = {}
     for split in ("handwritten", "compositional"):
@@ -61,6 +61,7 @@ def main() -> None:
     total = sum(bool(r["equivalent"]) for r in rows)
     print(f"\nall: {total}/{len(rows)} ({100 * total / len(rows):.1f}%), "
           f"model {translator.backend.model_id}, {k} shots")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps({
         "date": date.today().isoformat(), "machine": platform.platform(),
         "model": translator.backend.model_id, "shots": k, "equivalent": total,
