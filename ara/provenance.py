@@ -9,6 +9,12 @@ from functools import lru_cache
 from pathlib import Path
 
 
+def cache_root() -> Path:
+    """Where converted models, tools and indexes are kept: ``$ARA_CACHE``, else
+    ``~/.cache/ara``."""
+    return Path(os.environ.get("ARA_CACHE", Path.home() / ".cache" / "ara"))
+
+
 def sha256_file(path: str | Path) -> str:
     """Hex sha256 of a file's bytes; cached while its size and mtime stay the same."""
     stat = os.stat(path)

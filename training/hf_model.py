@@ -11,13 +11,12 @@ the folder and return at once. Nothing is downloaded.
 from __future__ import annotations
 
 import json
-import os
 import shutil
 from pathlib import Path
 
 from ara import __version__
 from ara.errors import AraError
-from ara.provenance import sha256_file
+from ara.provenance import cache_root, sha256_file
 
 MANIFEST = "ara_model.json"
 #: Bumped when the folder's layout changes, so older conversions are redone.
@@ -26,11 +25,6 @@ FORMAT = 2
 
 class ModelPrepError(AraError, RuntimeError):
     """The base model could not be converted or found."""
-
-
-def cache_root() -> Path:
-    """``$ARA_CACHE``, else ``~/.cache/ara``."""
-    return Path(os.environ.get("ARA_CACHE", Path.home() / ".cache" / "ara"))
 
 
 def default_hf_dir() -> Path:
