@@ -239,6 +239,11 @@ def ablation_cmd(
                                  help="Comma list of variants: letters F, P, C joined by "
                                       "+, or none (zero-shot, unconstrained)."),
     shots: str = typer.Option("5,20", "--shots", help="Comma list of few-shot counts."),
+    examples_by: str = typer.Option(
+        "random", "--examples-by",
+        help="How the F variants' worked examples are chosen: random (drawn with --seed, "
+             "the same for every test pair of a rerun) or similar (for each test pair, "
+             "the pool's pairs most like it; never one with the test's own sentence)."),
     reruns: int = typer.Option(3, "--reruns", help="Reruns, each with new examples."),
     limit: int = typer.Option(1000, "--limit", help="Test pairs to sample."),
     seed: int = typer.Option(0, "--seed", help="Seeds the test sample and the examples."),
@@ -290,7 +295,7 @@ def ablation_cmd(
             variants=split_list(variants),
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
-            repair_by=repair_by, repair_doubt=doubt,
+            repair_by=repair_by, repair_doubt=doubt, examples_by=examples_by,
         )
         loaded = load_data(config)
         plan(config, loaded)  # a bad file or plan is named before the model loads

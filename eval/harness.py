@@ -25,6 +25,7 @@ from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
 from ara.eval.confidence import DOUBT
 from ara.eval.consistency import REPAIR_BY, translate_repaired
 from ara.eval.prompt import Shot, sample_shots
+from ara.eval.similar import EXAMPLES_BY, index_for
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
@@ -115,6 +116,10 @@ class AblationConfig:
         repair_doubt: By ``samples+edits``: also draw for a complete greedy answer the
             model gives a probability below this, 0 to 1 (0: gaps only; runs repaired
             before it existed read as 0).
+        examples_by: How the F variants' worked examples are chosen: ``random`` (drawn
+            with the seed, the same for every test pair of a rerun) or ``similar`` (for
+            each test pair, the pool's pairs most like it, :mod:`ara.eval.similar`,
+            never one that says the test's own sentence).
     """
 
     split: str = "paper"
@@ -133,6 +138,7 @@ class AblationConfig:
     repair_doubt: float = DOUBT
     data: str | None = None
     examples: str | None = None
+    examples_by: str = "random"
 
     def __post_init__(self) -> None:
         if self.split == FILE_SPLIT:
@@ -160,6 +166,9 @@ class AblationConfig:
             )
         if not 0 <= self.repair_doubt <= 1:
             raise ConfigError(f"repair_doubt is a probability, 0 to 1; got {self.repair_doubt}")
+        if self.examples_by not in EXAMPLES_BY:
+            raise ConfigError(f"examples by {self.examples_by!r}? choose one of "
+                              f"{', '.join(EXAMPLES_BY)}")
         if self.repair_by not in REPAIR_BY:
             raise ConfigError(f"repair by {self.repair_by!r}? choose one of "
                               f"{', '.join(REPAIR_BY)}")
@@ -171,6 +180,8 @@ class AblationConfig:
             del data["repair"], data["repair_by"], data["repair_doubt"]
         if self.split != FILE_SPLIT:  # the same for runs from before files could be read
             del data["data"], data["examples"]
+        if self.examples_by == "random":  # and before examples could be chosen by similarity
+            del data["examples_by"]
         return data
 
     @classmethod
@@ -264,8 +275,12 @@ def _jobs(config: AblationConfig, tests: list[Record], pool: list[Record],
                 continue
             rng = random.Random(f"{config.seed}:{rerun}:{shots}")
             examples = tuple(sample_shots(pool, shots, rng)) if shots else ()
+            similar = index_for(pool) if shots and config.examples_by == "similar" else None
             for variant in group:
                 for record in tests:
+                    if similar is not None and variant.few_shot:
+                        examples = tuple(map(Shot.of, similar.nearest(
+                            record.nl, record.aps, shots, other_sentences=True)))
                     yield Job(rerun, shots, variant, record, examples)
 
 
