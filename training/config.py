@@ -27,6 +27,12 @@ def _build(cls, data: dict | None, where: str):
     return cls(**data)
 
 
+#: The shipped adapters in the PEFT form training starts from, by ``--model`` name. (The
+#: run chain's record keeps it until it moves beside the GGUF in ``eval/models/``.)
+SHIPPED_PEFT = {"finetuned": Path(__file__).parents[1] / "docs" / "results" / "training"
+                / "compositional-270m-soup-v16v17" / "adapter"}
+
+
 @dataclass(frozen=True)
 class LoraSettings:
     """The adapter.
@@ -95,6 +101,10 @@ class DataSettings:
             count >= 1; sources not named occur once), e.g. ``{nl2tl_timed_train: 2}``
             to weight a part of the mixture up without a new data version. The copies
             count in ``train_examples`` and are drawn as worked examples as often.
+        pairs: A file of your own pairs (JSON Lines as ``ara translate-file`` reads,
+            each line with its reference ``stl``), added to the split's training
+            records as the source ``pairs`` (weight them with ``repeat: {pairs: N}``);
+            ``run.json`` records its hash.
     """
 
     split: str = "paper"
@@ -104,6 +114,7 @@ class DataSettings:
     limit: int | None = None
     shots: tuple[int, ...] = (0,)
     repeat: dict[str, int] = field(default_factory=dict)
+    pairs: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "forms", tuple(self.forms))
@@ -137,6 +148,8 @@ class TrainConfig:
         init_adapter: A PEFT adapter folder (``adapter/`` of an earlier run) to start
             from instead of a fresh LoRA: a warm start with its own optimizer and
             schedule, for a second pass or new data. Its LoRA shape must match ``lora``.
+            ``finetuned`` names the shipped adapter (``--model finetuned``) in its PEFT
+            form, to adapt it to pairs of your own.
         max_steps: Stop after this many optimizer steps (``None``: the epochs decide).
         checkpoint_every: Save a resumable checkpoint every N steps, >= 1.
         keep_checkpoints: How many of the newest checkpoints to keep, >= 1. Each holds
@@ -166,6 +179,13 @@ class TrainConfig:
                               "eval_pairs >= 0")
         if self.init_adapter is not None and not str(self.init_adapter).strip():
             raise ConfigError("init_adapter must be an adapter folder or null, got ''")
+
+    @property
+    def init_adapter_folder(self) -> Path | None:
+        """Where ``init_adapter`` is: a folder, or the shipped adapter's by its name."""
+        if self.init_adapter is None:
+            return None
+        return SHIPPED_PEFT.get(self.init_adapter, Path(self.init_adapter))
 
     @classmethod
     def from_dict(cls, data: dict) -> TrainConfig:

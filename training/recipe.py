@@ -52,7 +52,8 @@ class LoRAFinetuneRecipe:
             raise ConfigError(f"{self.out} already holds a run: pass --resume or another out")
         if resume and self.out.joinpath("run.json").exists():
             _refuse_changed_config(self.out / "run.json", config)
-        if config.init_adapter and not Path(config.init_adapter, "adapter_config.json").is_file():
+        if config.init_adapter and not Path(config.init_adapter_folder,
+                                            "adapter_config.json").is_file():
             raise ConfigError(
                 f"init_adapter: {config.init_adapter} holds no adapter_config.json; name the "
                 "adapter/ folder of a finished run (train that run first)")
@@ -101,6 +102,7 @@ class LoRAFinetuneRecipe:
 
     def _load_data(self):
         from ara.data import load_split
+        from ara.provenance import sha256_file
 
         data = self.config.data
         split = load_split(data.split, data.seed, version=data.version)
@@ -111,9 +113,16 @@ class LoRAFinetuneRecipe:
                     f"--resume: {self.out} was started on {data.split} version {started}, "
                     f"but this release loads {split.version}; pin data.version: {started} "
                     "in the config")
+            pairs = json.loads(self.out.joinpath("run.json").read_text())["data"].get(
+                "pairs_sha256")
+            if data.pairs and pairs != sha256_file(data.pairs):
+                raise ConfigError(f"--resume: {data.pairs} changed since {self.out} started; "
+                                  "train the new pairs into another out folder")
         records = [r for f in self.config.data.forms for r in split.records("train", f)]
         if self.config.data.limit:
             records = records[: self.config.data.limit]
+        if data.pairs:
+            records += [r for r in own_pairs(data.pairs) if r.form in data.forms]
         return repeat_sources(records, self.config.data.repeat), split
 
     def _lora_model(self):
@@ -125,7 +134,7 @@ class LoRAFinetuneRecipe:
                                                     dtype=dtype)
         lora = self.config.lora
         if self.config.init_adapter:
-            return _warm_started(base, self.config.init_adapter, lora)
+            return _warm_started(base, str(self.config.init_adapter_folder), lora)
         return get_peft_model(base, LoraConfig(
             r=lora.r, lora_alpha=lora.alpha, lora_dropout=lora.dropout,
             target_modules=lora.target_modules, task_type="CAUSAL_LM"))
@@ -138,17 +147,19 @@ class LoRAFinetuneRecipe:
 
     def _provenance(self) -> dict:
         from ara.grammars import GRAMMAR_VERSION
-        from ara.provenance import git_commit
+        from ara.provenance import git_commit, sha256_file
 
         manifest = Path(self.model_dir, "ara_model.json")
         base_hash = json.loads(manifest.read_text())["gguf_sha256"] if manifest.exists() else None
         return {"config": self.config.to_dict(), "ara_version": __version__,
                 "git_commit": git_commit(), "grammar_version": GRAMMAR_VERSION,
                 "data": {"split": self.config.data.split, "version": self.split.version,
-                         "train_examples": len(self.train_records)},
+                         "train_examples": len(self.train_records),
+                         **({"pairs_sha256": sha256_file(self.config.data.pairs)}
+                            if self.config.data.pairs else {})},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "processes": self.accelerator.num_processes,
-                "init_adapter": _adapter_identity(self.config.init_adapter),
+                "init_adapter": _adapter_identity(self.config.init_adapter_folder),
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
 
@@ -329,7 +340,17 @@ def _warm_started(base, folder: str, lora):
     return model
 
 
-def _adapter_identity(folder: str | None) -> dict | None:
+def own_pairs(path: str) -> list:
+    """A user's pairs file as training records of the source ``pairs``."""
+    from dataclasses import replace
+
+    from ara.eval.translator import TranslatorConfig
+    from ara.eval.user_data import read_pairs
+
+    return [replace(r, source="pairs") for r in read_pairs(Path(path), TranslatorConfig())]
+
+
+def _adapter_identity(folder: str | Path | None) -> dict | None:
     """Where a warm start came from: the folder and its weights' hash."""
     if not folder:
         return None

@@ -228,3 +228,32 @@ def test_merging_an_adapter_saved_without_a_tokenizer_takes_the_bases(tiny_gemma
     merged = merge_adapter(str(tiny_gemma_dir), str(tmp_path / "adapter"), tmp_path / "merged")
     ours, base = (AutoTokenizer.from_pretrained(d) for d in (merged, tiny_gemma_dir))
     assert ours("always ( prop_1 )")["input_ids"] == base("always ( prop_1 )")["input_ids"]
+
+
+def test_your_own_pairs_join_the_training_records(tiny_gemma_dir, tmp_path):
+    """Tests ``data.pairs``: a user's file becomes training records of the source
+    ``pairs``, weighted by ``repeat``, its hash recorded; the shipped adapter is a
+    warm start by its name."""
+    pairs = tmp_path / "lab.jsonl"
+    pairs.write_text('{"nl": "Sweep field 2.", "aps": ["at_field_2"], '
+                     '"stl": "G(F(at_field_2))"}\n'
+                     '{"nl": "Hold at the shed.", "aps": ["at_shed"], "stl": "G(at_shed)"}\n')
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=1,
+                         data={"forms": ["grounded"], "limit": 4, "pairs": str(pairs),
+                               "repeat": {"pairs": 3}})
+    recipe = LoRAFinetuneRecipe(config)
+    recipe.setup()
+    assert len(recipe.train_records) == 4 + 2 * 3
+    assert sum(r.source == "pairs" for r in recipe.train_records) == 6
+    run = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert len(run["data"]["pairs_sha256"]) == 64
+    shipped = TrainConfig.from_dict({**config.to_dict(), "init_adapter": "finetuned"})
+    assert (shipped.init_adapter_folder / "adapter_config.json").is_file()
+
+
+def test_a_lab_pairs_config_names_a_file_that_exists():
+    from pathlib import Path
+
+    root = Path(__file__).parents[2]
+    config = TrainConfig.from_yaml(root / "training" / "configs" / "gemma3_270m_lab_pairs.yaml")
+    assert (root / config.data.pairs).is_file() and config.init_adapter == "finetuned"
