@@ -65,11 +65,13 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
 def translator(model: str = "finetuned", config=None, server: str = "openai"):
     """The :class:`~ara.eval.translator.Translator` for ``model`` and ``config`` (a
     :class:`~ara.eval.translator.TranslatorConfig`), loaded once and kept: loading the
-    embedded model takes seconds, a translation a fraction of one."""
-    from ara.eval.models import make_backend
+    embedded model takes seconds, a translation a fraction of one. Translators of one
+    model with other configs share its backend
+    (:func:`~ara.eval.models.shared_backend`)."""
+    from ara.eval.models import shared_backend
     from ara.eval.translator import Translator
 
-    return Translator(make_backend(model, server=server), config)
+    return Translator(shared_backend(model, server=server), config)
 
 
 def explain(formula: str) -> str:

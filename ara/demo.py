@@ -84,14 +84,14 @@ def _help_round(translator) -> None:
 def _translate_some(model: str, n: int, seed: int, k: int):
     from ara.data import prepare
     from ara.eval.harness import judge
-    from ara.eval.models import make_backend
+    from ara.eval.models import shared_backend
     from ara.eval.prompt import sample_shots
     from ara.eval.translator import Translator
 
     rng = random.Random(seed)
     pool = prepare("compositional", 0).records("train", "grounded")
     shots = sample_shots(pool, k, rng) if k else []
-    translator = Translator(make_backend(model))
+    translator = Translator(shared_backend(model))
     typer.echo(f"\n== translate: hand-written sentences no model trained on; "
                f"{translator.backend.model_id}, {k} shots, grammar-constrained")
     for r in rng.sample(prepare("handwritten", 0).records("test", "grounded"), n):

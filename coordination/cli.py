@@ -17,10 +17,10 @@ def _translator(llm: str):
     """None for --llm none; else the eval translator over that model."""
     if llm == "none":
         return None
-    from ara.eval.models import make_backend
+    from ara.eval.models import shared_backend
     from ara.eval.translator import Translator
 
-    return Translator(make_backend(llm))
+    return Translator(shared_backend(llm))
 
 
 @coord_app.command("exp2")

@@ -171,7 +171,7 @@ def translate_file_cmd(
         summary_table,
         translate_requests,
     )
-    from ara.eval.models import make_backend
+    from ara.eval.models import shared_backend
     from ara.eval.translator import Translator, TranslatorConfig
 
     with user_errors():
@@ -185,7 +185,7 @@ def translate_file_cmd(
         if out.exists() and out.stat().st_size and not resume:
             raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
                               "another --out")
-        translator = Translator(make_backend(model, server=server), config)
+        translator = Translator(shared_backend(model, server=server), config)
         done = done_lines(out, todo, translator.backend.model_id)
         examples: dict[str, list] = {}
 

@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 from ara.eval.backends.base import Backend, BackendError
@@ -74,3 +75,30 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
         "ending in .gguf, "
         "hf:FOLDER_OR_ID, or an http(s):// endpoint"
     )
+
+
+def shared_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
+                   api_model: str | None = None, server: str = "openai") -> Backend:
+    """:func:`make_backend`'s backend for these arguments, loaded once per process and
+    kept (the four most recent; the same arguments by position, by name or left to
+    their defaults are one entry): loading the embedded model and an adapter takes
+    seconds, a translation a fraction of one. ``ara translate``, ``ara translate-file``,
+    ``ara demo`` and :func:`ara.translate` share it, so a process that translates with
+    several settings loads each model once. Sharing changes no answer: a local
+    backend answers a prompt as a fresh one does, whatever it was asked before (see
+    its prefix reuse). A model that fails to load is not kept;
+    ``shared_backend.cache_clear()`` lets the loaded ones go.
+
+    Raises:
+        BackendError: As :func:`make_backend`.
+    """
+    return _shared(model, n_ctx, mask, api_model, server)  # one key however it is called
+
+
+@lru_cache(maxsize=4)
+def _shared(model: str, n_ctx: int, mask: str, api_model: str | None, server: str) -> Backend:
+    return make_backend(model, n_ctx=n_ctx, mask=mask, api_model=api_model, server=server)
+
+
+shared_backend.cache_clear = _shared.cache_clear
+shared_backend.cache_info = _shared.cache_info

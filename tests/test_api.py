@@ -31,7 +31,8 @@ def test_a_request_the_command_refuses_is_refused_before_loading_a_model():
 @needs_llama
 def test_translate_gives_the_command_s_answer_and_keeps_the_model_loaded():
     """Tests ara.translate with the shipped fine-tune: the `--json` object, the model
-    loaded once for two calls, and the module's own examples."""
+    loaded once for two calls and shared by translators of other settings, and the
+    module's own examples."""
     ara.translator.cache_clear()
     answer = ara.translate("Never enter the server room.", ["enter_server_room"])
     assert answer["stl"] == "G(!enter_server_room)" and answer["valid"]
@@ -41,4 +42,11 @@ def test_translate_gives_the_command_s_answer_and_keeps_the_model_loaded():
     timed = ara.translate("within 20 steps reach ( prop_1 )", ["prop_1"], repair=0)
     assert timed["stl"] == "F[0,20](prop_1)" and "samples" not in timed  # greedy
     assert ara.translator.cache_info().misses == 1  # one load for both
+    # other settings, and the command line's own path, share the model loaded
+    from ara.eval.models import shared_backend
+    from ara.eval.translator import TranslatorConfig
+
+    untimed = ara.translator("finetuned", TranslatorConfig(intervals=False))
+    assert untimed.backend is ara.translator("finetuned", None).backend
+    assert untimed.backend is shared_backend("finetuned")
     assert doctest.testmod(ara.api).failed == 0
