@@ -27,7 +27,7 @@ from ara.grammars import parse
 def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
               shots: int | None = None, seed: int = 0, intervals: bool = True,
               max_bound: int = 1000, any_bound: bool = False, server: str = "openai",
-              **how) -> dict:
+              examples_by: str = "random", examples: str | None = None, **how) -> dict:
     """Translate one instruction into STL over ``aps``, as ``ara translate`` does.
 
     Args:
@@ -36,6 +36,9 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
         model, shots, seed, intervals, max_bound, any_bound, server: As the command's
             options of the same names (``model``: ``finetuned``, ``default``,
             ``lora:FILE``, a GGUF path, ``hf:FOLDER`` or an ``http(s)://`` endpoint).
+        examples_by, examples: How the ``shots`` worked examples are chosen (``random``
+            or ``similar`` to ``nl``) and from which file of pairs (``None``: the
+            training mixture), as ``--examples-by`` and ``--examples``.
         **how: Fields of :class:`~ara.eval.answering.AnswerConfig` (``repair``,
             ``samples``, ``doubt``, ``alternatives``, ...).
 
@@ -57,8 +60,8 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
     check_request(nl, aps, config)
     # Options and worked examples first: a mistake there is refused before the model loads.
     how = AnswerConfig(seed=seed, **how)
-    examples = worked_examples(model, shots, aps, seed)
-    return answer(translator(model, config, server), nl, aps, examples, how)
+    shown = worked_examples(model, shots, aps, seed, nl, examples_by, examples)
+    return answer(translator(model, config, server), nl, aps, shown, how)
 
 
 @lru_cache(maxsize=4)

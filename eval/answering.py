@@ -12,6 +12,8 @@ import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 from ara.errors import ConfigError
 from ara.eval.confidence import DOUBT, doubt_warning, result_probability, winner_probability
@@ -161,20 +163,52 @@ def _significant(p: float) -> float:
     return float(f"{p:.3g}")
 
 
-def worked_examples(model: str, shots: int | None, aps: Sequence[str],
-                    seed: int = 0) -> list[Shot]:
-    """The worked examples a prompt for ``aps`` shows: ``shots`` of them (``None``: the
-    model's default, none for the fine-tuned adapters) from the compositional train
-    side, of the propositions' form (lifted or grounded), picked by ``seed``."""
-    from ara.data import load_or_prepare  # prepares the split on first use
+def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int = 0,
+                    nl: str = "", by: str = "random",
+                    pool: str | Path | None = None) -> list[Shot]:
+    """The worked examples a prompt for ``nl`` over ``aps`` shows.
+
+    Args:
+        model: The ``--model``; it sets the default count.
+        shots: How many (``None``: the model's default, none for the fine-tuned adapters).
+        aps: The request's propositions: examples are of their form (lifted or grounded).
+        seed: Which examples ``random`` draws.
+        nl: The request's sentence, which ``similar`` compares the pool's with.
+        by: ``random`` (the same examples for every request of a form) or ``similar``
+            (the pool's pairs most like this request, :mod:`ara.eval.similar`).
+        pool: A file of one's own pairs to choose from (the lines `translate-file`
+            reads, each with its reference); default: the compositional train side.
+    """
     from ara.data.normalize import form_of
     from ara.eval.models import default_shots
+    from ara.eval.similar import EXAMPLES_BY, index_for
 
+    if by not in EXAMPLES_BY:
+        raise ConfigError(f"examples by {by!r}? choose one of {', '.join(EXAMPLES_BY)}")
     k = shots if shots is not None else default_shots(model)
     if not k:
         return []
-    pool = load_or_prepare("compositional").records("train", form_of(tuple(aps)))
-    return sample_shots(pool, k, random.Random(seed))
+    form = form_of(tuple(aps))
+    if pool is None:
+        from ara.data import load_or_prepare  # prepares the split on first use
+
+        records = load_or_prepare("compositional").records("train", form)
+    else:
+        records = [r for r in _pool_file(str(pool)) if r.form == form]
+    if k > len(records):
+        raise ConfigError(f"{k} worked examples asked for (--shots), but the pool has only "
+                          f"{len(records)} {form} pairs")
+    if by == "similar":
+        return [Shot.of(r) for r in index_for(records).nearest(nl, aps, k)]
+    return sample_shots(records, k, random.Random(seed))
+
+
+@lru_cache(maxsize=4)
+def _pool_file(path: str) -> tuple:
+    from ara.eval.translator import TranslatorConfig
+    from ara.eval.user_data import read_pairs
+
+    return tuple(read_pairs(Path(path), TranslatorConfig()))
 
 
 def notes(data: dict, nl: str = "") -> list[str]:

@@ -150,12 +150,12 @@ def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int
 
 
 def translate_requests(translator: Translator, requests: Iterable[FileRequest], out: Path,
-                       shots_for: Callable[[Sequence[str]], Sequence[Shot]],
+                       shots_for: Callable[[str, Sequence[str]], Sequence[Shot]],
                        config: AnswerConfig | None = None,
                        spot_timeout_s: float = 10.0) -> Iterable[dict]:
     """Answer each request, append its line to ``out`` (flushed at once), and yield it.
 
-    ``shots_for(aps)`` gives the worked examples for a request's propositions. A line is
+    ``shots_for(nl, aps)`` gives the worked examples for a request. A line is
     the request (``line``, ``id`` if any, ``nl``, ``aps``) and :func:`answer`'s dict;
     with a reference, also ``reference`` and Spot's ``equivalent`` (``None``:
     undecided in ``spot_timeout_s``).
@@ -167,7 +167,8 @@ def translate_requests(translator: Translator, requests: Iterable[FileRequest], 
             if request.id is not None:
                 row["id"] = request.id
             row |= {"nl": request.nl, "aps": list(request.aps)}
-            row |= answer(translator, request.nl, request.aps, shots_for(request.aps), config)
+            shown = shots_for(request.nl, request.aps)
+            row |= answer(translator, request.nl, request.aps, shown, config)
             if request.reference is not None:
                 row["reference"] = request.reference
                 row["equivalent"] = judge(request.reference, row["stl"],

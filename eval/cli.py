@@ -32,6 +32,16 @@ SHOTS = typer.Option(
     help="Worked examples from the compositional train side; default 0 for the "
          "fine-tuned adapters, 5 for other models.")
 SEED = typer.Option(0, "--seed", help="Which worked examples, and the samples' seeds.")
+EXAMPLES_BY = typer.Option(
+    "random", "--examples-by",
+    help="How the --shots worked examples are chosen: random (drawn with --seed, the same "
+         "for every request) or similar (the pool's pairs whose wording is most like the "
+         "request's, its propositions' own words aside).")
+EXAMPLES = typer.Option(
+    None, "--examples", dir_okay=False, exists=True,
+    help="A file of your own pairs to take worked examples from (JSON Lines as "
+         "translate-file reads, each line with its reference \"stl\"); default: the "
+         "training mixture. Use with --shots and --examples-by similar.")
 INTERVALS = typer.Option(
     True, "--intervals/--no-intervals",
     help="Allow time bounds (F[a,b], G[a,b], U[a,b]); on by default, and an untimed "
@@ -83,6 +93,8 @@ def translate_cmd(
     grammar_in_prompt: bool = typer.Option(False, "--grammar-in-prompt",
                                            help="Show the grammar in the prompt."),
     shots: int | None = SHOTS,
+    examples_by: str = EXAMPLES_BY,
+    examples: Path | None = EXAMPLES,
     seed: int = SEED,
     intervals: bool = INTERVALS,
     max_bound: int = MAX_BOUND,
@@ -115,6 +127,7 @@ def translate_cmd(
 
     with user_errors():  # the same path as ara.translate from Python
         data = translate(nl, split_list(aps), model, shots=shots, seed=seed,
+                         examples_by=examples_by, examples=examples,
                          intervals=intervals, max_bound=max_bound, any_bound=any_bound,
                          server=server, samples=samples, repair=repair, repair_by=repair_by,
                          doubt=doubt, temperature=temperature,
@@ -135,6 +148,8 @@ def translate_file_cmd(
                                 help="Go on with an --out an interrupted run left."),
     model: str = MODEL,
     shots: int | None = SHOTS,
+    examples_by: str = EXAMPLES_BY,
+    examples: Path | None = EXAMPLES,
     seed: int = SEED,
     intervals: bool = INTERVALS,
     max_bound: int = MAX_BOUND,
@@ -187,14 +202,16 @@ def translate_file_cmd(
                               "another --out")
         translator = Translator(shared_backend(model, server=server), config)
         done = done_lines(out, todo, translator.backend.model_id)
-        examples: dict[str, list] = {}
+        drawn: dict[str, list] = {}
 
-        def shots_for(aps: tuple[str, ...]) -> list:
+        def shots_for(nl: str, aps: tuple[str, ...]) -> list:
+            if examples_by == "similar":
+                return worked_examples(model, shots, aps, seed, nl, examples_by, examples)
             # The same examples for every request of a form, as ara translate would pick.
             form = form_of(aps)
-            if form not in examples:
-                examples[form] = worked_examples(model, shots, aps, seed)
-            return examples[form]
+            if form not in drawn:
+                drawn[form] = worked_examples(model, shots, aps, seed, pool=examples)
+            return drawn[form]
 
         if done:
             typer.echo(f"resuming {out} after {done} of {len(todo)} answers", err=True)

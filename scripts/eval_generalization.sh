@@ -17,6 +17,10 @@
 # $REPAIR answers drawn where sampling is the way), by $REPAIR_BY (default samples+edits),
 # also acting on a complete answer the model gives a probability below $DOUBT (default
 # 0.5; 0: gaps only).
+# $SHOTS (default 5) are the F variants' worked examples, chosen by $EXAMPLES_BY (default
+# random; similar: each test pair's most similar pairs of the pool, never its own sentence).
+# The set timed-unseen is NL2TL's timed dev pairs whose sentence no training pair says
+# (written to runs/data/timed-unseen.jsonl and read with --data).
 # Each run resumes from its samples.
 # `scripts/generalization_table.py` prints the table from what is there.
 set -euo pipefail
@@ -30,7 +34,8 @@ out=runs/generalization/$name
 
 run() {  # SPLIT FORM LIMIT [VARIANTS]
   .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \
-    --variants "${4:-$variants}" --shots 5 --reruns 1 --seed 0 --spot-timeout 5 --resume \
+    --variants "${4:-$variants}" --shots "${SHOTS:-5}" --examples-by "${EXAMPLES_BY:-random}" \
+    --reruns 1 --seed 0 --spot-timeout 5 --resume \
     --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" --doubt "${DOUBT:-0.5}" \
     --no-progress --out "$out/$1-$2" > /dev/null
   echo "done: $name $1 $2"
@@ -42,9 +47,27 @@ for set in $sets; do
     run "$set" lifted 200; run "$set" grounded 200 ;;
   compositional) run compositional lifted "${LIMIT:-50}"; run compositional grounded "${LIMIT:-50}" ;;
   timed) run timed lifted "${LIMIT:-100}" ;;
+  timed-unseen)
+    mkdir -p runs/data
+    .venv/bin/python - <<'PY'
+import json
+from ara.data import load_or_prepare
+from ara.data.mixture import sentence_key
+seen = {sentence_key(r.nl) for r in load_or_prepare("compositional").records("train")}
+with open("runs/data/timed-unseen.jsonl", "w") as f:
+    for r in load_or_prepare("timed").records("test"):
+        if sentence_key(r.nl) not in seen:
+            f.write(json.dumps({"nl": r.nl, "aps": list(r.aps), "stl": r.stl}) + "\n")
+PY
+    .venv/bin/ara eval ablation --data runs/data/timed-unseen.jsonl --limit "${LIMIT:-100}" \
+      --model "$model" --variants "$variants" --shots "${SHOTS:-5}" \
+      --examples-by "${EXAMPLES_BY:-random}" --reruns 1 --seed 0 --spot-timeout 5 --resume \
+      --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" --doubt "${DOUBT:-0.5}" \
+      --no-progress --out "$out/timed-unseen-lifted" > /dev/null
+    echo "done: $name timed-unseen" ;;
   paper|disjoint) run "$set" lifted "${LIMIT:-100}" "${VARIANTS:-C,F+C}" ;;
   *) echo "unknown set $set (handwritten handwritten2 handwritten3 handwritten4 compositional" \
-          "timed paper disjoint)" >&2
+          "timed timed-unseen paper disjoint)" >&2
      exit 2 ;;
   esac
 done

@@ -73,3 +73,27 @@ def test_the_harness_gives_each_test_pair_its_own_similar_examples(paper_split):
     assert "examples_by" not in AblationConfig(split="paper").to_dict()  # old runs resume
     with pytest.raises(Exception, match="examples by 'nearest'"):
         AblationConfig(split="paper", examples_by="nearest")
+
+
+def test_your_own_pairs_give_the_examples_most_like_the_request(tmp_path):
+    """Tests `ara translate --shots 1 --examples-by similar --examples FILE`'s choice: the
+    pair of the user's file whose wording is most like the request, of the request's
+    form; random draws from the same file; a bad option is named."""
+    import json
+
+    from ara.errors import ConfigError
+    from ara.eval.answering import worked_examples
+
+    pairs = tmp_path / "lab.jsonl"
+    pairs.write_text("".join(json.dumps({"nl": r.nl, "aps": list(r.aps), "stl": r.stl}) + "\n"
+                             for r in POOL))
+    shown = worked_examples("finetuned", 1, ["hold_dock", "hold_gate"], nl="Hold the dock, "
+                            "then the gate.", by="similar", pool=pairs)
+    assert [s.stl for s in shown] == ["F(go_to_kitchen & F(go_to_garage))"]
+    drawn = worked_examples("finetuned", 2, ["a_b"], seed=1, pool=pairs)
+    assert len(drawn) == 2 and {s.nl for s in drawn} <= {r.nl for r in POOL}
+    assert worked_examples("finetuned", None, ["a_b"], nl="x", by="similar", pool=pairs) == []
+    with pytest.raises(ConfigError, match="only 4 grounded pairs"):
+        worked_examples("finetuned", 5, ["a_b"], pool=pairs)
+    with pytest.raises(ConfigError, match="examples by 'closest'"):
+        worked_examples("finetuned", 1, ["a_b"], by="closest", pool=pairs)
