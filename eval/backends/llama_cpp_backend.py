@@ -49,7 +49,9 @@ class LlamaCppBackend:
     Args:
         model_path: Path to a ``.gguf`` file.
         n_ctx: Context length in tokens; 20-shot prompts need about 1,500.
-        n_threads: CPU threads; default all cores.
+        n_threads: CPU threads; default ``$ARA_THREADS``, else all cores. Beside another
+            busy process, one thread is far faster than two: llama.cpp's threads wait on
+            each other at every layer, and one of them is always waiting for a core.
         mask: ``llguidance`` (fast masks, default) or ``llama`` (llama.cpp's own
             grammar sampler on the GBNF text).
         lora_path: Optional GGUF LoRA adapter applied on top of the model.
@@ -72,7 +74,8 @@ class LlamaCppBackend:
             with muted_llama_log():
                 self.llm = llama_cpp.Llama(
                     model_path=str(model_path), n_ctx=n_ctx,
-                    n_threads=n_threads or os.cpu_count(), swa_full=True, verbose=False,
+                    n_threads=n_threads or int(os.environ.get("ARA_THREADS") or 0)
+                    or os.cpu_count(), swa_full=True, verbose=False,
                     lora_path=lora_path,
                 )
         except ValueError as err:

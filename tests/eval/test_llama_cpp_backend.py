@@ -151,3 +151,15 @@ def test_scores_do_not_depend_on_what_else_is_scored(llama_backend):
     assert together == alone
     assert all(x < 0 for x in together)
     assert llama_backend.score(prompt, []) == []
+
+
+@pytest.mark.slow  # two more model loads for a setting
+def test_the_thread_count_comes_from_the_caller_or_ara_threads(embedded_model_path,
+                                                               monkeypatch):
+    """Tests ARA_THREADS: beside another busy process, one thread beats all cores."""
+    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+
+    monkeypatch.setenv("ARA_THREADS", "1")
+    assert LlamaCppBackend(embedded_model_path).llm.context_params.n_threads == 1
+    monkeypatch.delenv("ARA_THREADS")
+    assert LlamaCppBackend(embedded_model_path, n_threads=3).llm.context_params.n_threads == 3
