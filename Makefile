@@ -11,11 +11,11 @@ setup:  ## create ./.venv with everything installed (idempotent; seconds when up
 demo: setup  ## the main job on the embedded defaults
 	$(BIN)/ara demo
 
-test: setup  ## the default (fast) test suite
-	$(BIN)/pytest -m "not slow and not gpu" $(PYTEST_ARGS)
+test: setup  ## the default (fast) test suite; prints its 15 slowest tests
+	$(BIN)/pytest -m "not slow and not gpu" --durations=15 $(PYTEST_ARGS)
 
-test-all: setup  ## every test, slow ones included
-	$(BIN)/pytest $(PYTEST_ARGS)
+test-all: setup  ## every test, slow ones included; prints its 15 slowest tests
+	$(BIN)/pytest --durations=15 $(PYTEST_ARGS)
 
 lint: setup
 	$(BIN)/ruff check ara grammars data eval training coordination tests bench scripts
