@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import subprocess
 
 import pytest
 from hypothesis import strategies as st
@@ -57,6 +58,36 @@ def formulas(aps=("a", "b", "c"), timed: bool = False, max_bound: int = 20,
     return st.recursive(leaves, extend, max_leaves=max_leaves)
 
 
+def run_ara(*args: str) -> subprocess.CompletedProcess:
+    """Run `ara ARGS` in this process (typer's runner on ``ara.cli.app``), as the
+    command line would, with its exit code, stdout and stderr: a model loads once per
+    session (``ara.eval.models.shared_backend``), not once per command. An exception the
+    command does not turn into an exit code (from the real command, a traceback) fails
+    the test."""
+    from typer.testing import CliRunner
+
+    from ara.cli import app
+
+    result = CliRunner().invoke(app, list(args))
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        raise result.exception
+    return subprocess.CompletedProcess(args, result.exit_code, result.stdout, result.stderr)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Let the models the session shared go while the interpreter is whole: llama.cpp's
+    finalizer fails noisily when it runs at interpreter shutdown."""
+    import gc
+    import sys
+
+    api, models = sys.modules.get("ara.api"), sys.modules.get("ara.eval.models")
+    if api is not None:
+        api.translator.cache_clear()
+    if models is not None:
+        models.shared_backend.cache_clear()
+    gc.collect()
+
+
 def _has(module: str) -> bool:
     return importlib.util.find_spec(module) is not None
 
@@ -79,20 +110,22 @@ def embedded_model_path() -> str:
 
 @pytest.fixture(scope="session")
 def llama_backend(embedded_model_path):
-    """The embedded Gemma 3 270M through llama.cpp, llguidance masks (loaded once)."""
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    """The embedded Gemma 3 270M through llama.cpp, llguidance masks (``--model
+    default``): loaded once, the very backend in-process `ara` commands use."""
+    from ara.eval.models import shared_backend
 
-    return LlamaCppBackend(embedded_model_path, n_ctx=4096)
+    return shared_backend("default")
 
 
 @pytest.fixture(scope="session")
 def finetuned(embedded_model_path):
-    """The shipped fine-tune (``--model finetuned``) through llama.cpp (loaded once)."""
-    from ara.eval.models import FINETUNED_LORA, make_backend
+    """The shipped fine-tune (``--model finetuned``) through llama.cpp: loaded once, the
+    very backend in-process `ara` commands and ``ara.translate`` use."""
+    from ara.eval.models import FINETUNED_LORA, shared_backend
 
     if not FINETUNED_LORA.is_file():
         pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (`ara train` rebuilds it)")
-    return make_backend("finetuned")
+    return shared_backend("finetuned")
 
 
 @pytest.fixture(scope="session")

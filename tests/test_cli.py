@@ -1,4 +1,9 @@
-"""The `ara` command line: the contract later work and external checks rely on."""
+"""The `ara` command line: the contract later work and external checks rely on.
+
+Commands run in this process (typer's runner on `ara.cli.app`), so a model loads once
+per session (`ara.eval.models.shared_backend`) rather than once per command; one test
+runs the installed entry point for real.
+"""
 
 import importlib.util
 import json
@@ -13,14 +18,15 @@ from typer.testing import CliRunner
 from ara.cli import app
 
 from conftest import needs_llama
+from conftest import run_ara as ara
 
 ARA = [str(Path(sys.executable).with_name("ara"))]
 runner = CliRunner()
 
 
-def ara(*args, **kwargs):
+def ara_process(*args: str) -> subprocess.CompletedProcess:
     """Run the installed `ara` entry point for real."""
-    return subprocess.run(ARA + list(args), capture_output=True, text=True, timeout=300, **kwargs)
+    return subprocess.run(ARA + list(args), capture_output=True, text=True, timeout=300)
 
 
 def test_parse_prints_canonical_form():
@@ -84,14 +90,15 @@ def test_grammar_with_bad_propositions_exits_2():
 
 def test_data_prepare_and_stats(tmp_path):
     """Tests `ara data prepare` then `ara data stats --json` on a fresh root, and stats
-    of a split the root lacks."""
+    of a split the root lacks, through the installed entry point: the note on stderr is
+    how the command line prints the library's warning."""
     out = ara("data", "prepare", "--split", "timed", "--root", str(tmp_path))
     assert out.returncode == 0 and "timed-" in out.stdout and "0 raw rows rejected" in out.stdout
     out = ara("data", "stats", "--split", "timed", "--root", str(tmp_path), "--json")
     stats = json.loads(out.stdout)
     assert stats["train"] == 6648 and stats["test"] == 1425 and stats["form"] == "lifted"
     # A split this root lacks is prepared on first use (deterministic, seconds), with a note.
-    out = ara("data", "stats", "--split", "paper", "--root", str(tmp_path))
+    out = ara_process("data", "stats", "--split", "paper", "--root", str(tmp_path))
     assert out.returncode == 0 and "| paper | 1de1d813ead6 | lifted |" in out.stdout
     assert "note: preparing the paper split on first use" in out.stderr
 

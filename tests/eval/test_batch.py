@@ -1,8 +1,6 @@
 """Translating a file of instructions: `ara translate-file` and ara.eval.batch."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -11,9 +9,7 @@ from ara.errors import ConfigError
 from ara.eval.batch import FileRequest, done_lines, read_requests, summarize, summary_table
 from ara.eval.translator import TranslatorConfig
 
-from conftest import needs_llama
-
-ARA = [str(Path(sys.executable).with_name("ara"))]
+from conftest import needs_llama, run_ara
 
 
 def _write(path: Path, *lines: str) -> Path:
@@ -114,8 +110,8 @@ def test_translate_file_answers_every_line_and_resumes_after_an_interruption(tmp
                       '{"nl": "Never enter the server room.", "aps": ["enter_server_room"], '
                       '"id": "lab-3"}')
     out = tmp_path / "out.jsonl"
-    args = [*ARA, "translate-file", str(requests), "--out", str(out), "--no-progress"]
-    run = subprocess.run([*args, "--json"], capture_output=True, text=True, timeout=600)
+    args = ["translate-file", str(requests), "--out", str(out), "--no-progress"]
+    run = run_ara(*args, "--json")
     assert run.returncode == 0, run.stderr
     summary = json.loads(run.stdout)
     assert summary["answers"] == 2 and summary["valid"] == 2
@@ -126,13 +122,12 @@ def test_translate_file_answers_every_line_and_resumes_after_an_interruption(tmp
     assert second["id"] == "lab-3" and second["stl"] == "G(!enter_server_room)"
     assert "reference" not in second
 
-    refused = subprocess.run(args, capture_output=True, text=True, timeout=600)
+    refused = run_ara(*args)
     assert refused.returncode == 2 and "exists: pass --resume" in refused.stderr
-    folder = subprocess.run([*args[:-3], "--out", str(tmp_path)], capture_output=True, text=True,
-                            timeout=600)
+    folder = run_ara(*args[:-3], "--out", str(tmp_path))
     assert folder.returncode == 2 and "is a folder: name the JSON Lines file" in folder.stderr
     out.write_text(out.read_text().splitlines(keepends=True)[0] + '{"line": 2, "n')
-    resumed = subprocess.run([*args, "--resume"], capture_output=True, text=True, timeout=600)
+    resumed = run_ara(*args, "--resume")
     assert resumed.returncode == 0, resumed.stderr
     assert "resuming" in resumed.stderr
     assert "| equivalent to the reference | 1 of 1" in resumed.stdout
