@@ -46,7 +46,7 @@ def data_dir(tmp_path_factory):
         os.environ["ARA_DATA_DIR"] = old
 
 
-@pytest.mark.parametrize("seed", range(2))
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_random_arguments_never_end_in_a_traceback(seed, data_dir):
     rng = random.Random(seed)
     for _ in range(60):

@@ -7,7 +7,6 @@ import pytest
 from ara.coordination.demos import ERRANDS, run_demo
 from ara.eval.confidence import DOUBT
 from ara.eval.coverage import gaps
-from ara.eval.models import FINETUNED_LORA, make_backend
 from ara.eval.translator import Translator
 from ara.grammars import parse
 
@@ -15,15 +14,13 @@ from conftest import needs_llama
 
 
 @needs_llama
-@pytest.mark.parametrize("name", ["kitting", "tool"])
-def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path):
+@pytest.mark.parametrize("name", ["kitting", pytest.param("tool", marks=pytest.mark.slow)])
+def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path, finetuned):
     """Tests the demo's translation path: the formula it plans from is the repaired
     translation, a warning names anything it still leaves out, and a note follows a
     formula the model doubts."""
-    if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
     lines = []
-    result = run_demo(name, tmp_path, Translator(make_backend("finetuned")), lines.append)
+    result = run_demo(name, tmp_path, Translator(finetuned), lines.append)
     errand = ERRANDS[name]
     assert result["source"].startswith("translated by gguf:")
     assert any(line.startswith("[STL, translated by") for line in lines)

@@ -131,6 +131,9 @@ def test_the_config_checks_its_ranges(bad):
         Exp2Config(wordings="some")
 
 
+# Two trials of helpers translating with the base model; test_protocol's round trip
+# tests the help request in the default tier.
+@pytest.mark.slow
 def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
                                                                        llama_backend):
     """Tests that run.json names the translator's model (file hashes), that the same

@@ -109,18 +109,16 @@ def test_round_trip_with_the_embedded_llm(llama_backend):
 
 
 @pytest.fixture(scope="module")
-def shipped_translator():
-    """The shipped fine-tune through llama.cpp, loaded once."""
-    from ara.eval.models import FINETUNED_LORA, make_backend
+def shipped_translator(finetuned):
+    """The shipped fine-tune through llama.cpp (the session's one load)."""
     from ara.eval.translator import Translator
 
-    if not FINETUNED_LORA.is_file():
-        pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (`ara train` rebuilds it)")
-    return Translator(make_backend("finetuned"))
+    return Translator(finetuned)
 
 
 @pytest.mark.llm
-@pytest.mark.parametrize("wording", [0, 3, 7])  # the paper's words and two rewordings
+@pytest.mark.parametrize("wording", [  # the paper's words and two rewordings
+    0, pytest.param(3, marks=pytest.mark.slow), pytest.param(7, marks=pytest.mark.slow)])
 def test_the_shipped_translator_reads_a_reworded_request_as_the_template_spec(
         shipped_translator, wording):
     """Tests that a helper's translation of the request, however worded, is the

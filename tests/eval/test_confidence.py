@@ -28,6 +28,7 @@ def test_the_model_is_sure_of_a_sentence_it_reads_and_doubts_one_it_cannot(trans
     assert answer_probability(translator, nl, aps, None) is None  # no answer, nothing to score
 
 
+@pytest.mark.slow  # repair on test_finetuned's sentence again, 9 answers scored
 def test_a_repaired_answer_is_scored_as_if_asked_anew(translator):
     """Tests that the winner's probability taken from repair's scores is the one scoring
     it afresh gives (a batch rounds differently from feeding a token at a time, so
@@ -55,6 +56,7 @@ def test_the_note_reads_the_answer_back():
         '  F(a) & F(b)  (probability 0.35): "eventually a, and eventually b"')
 
 
+@pytest.mark.slow  # test_hf_backend checks the same sum on llama.cpp and transformers
 def test_decoding_scores_its_answer_on_the_way(translator):
     """Tests that the log-probability decoding sums while it writes an answer is the
     one scoring the answer afterwards gives, so the check on every answer costs no

@@ -57,6 +57,9 @@ def test_sampling_settings_are_checked():
         Sampling(temperature=0)
 
 
+# The base model's long samples; seeded samples are checked by the prefix-reuse test
+# and the vote's reproducibility in the default tier.
+@pytest.mark.slow
 @needs_llama
 def test_sampled_answers_are_valid_seeded_and_varied(llama_backend):
     """Tests that sampling under the grammar keeps every answer valid, that a seed fixes
@@ -99,6 +102,9 @@ def test_repair_keeps_greedy_unless_a_sample_leaves_out_less():
     assert rank_repairs(answers, [0, 0, 0, 0, 0])[0] == (0, 4)
 
 
+# The base model's long samples; when repair draws is tested on the shipped model below
+# (test_repair_searches_again_only_where_the_model_doubts_a_complete_answer).
+@pytest.mark.slow
 @needs_llama
 def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     """Tests that repair draws extra answers exactly when the greedy one leaves part of
@@ -124,6 +130,7 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
         translate_repaired(t, nl, aps, doubt=2)
 
 
+@pytest.mark.slow  # test_finetuned's repair by samples+edits and edits runs it on the shipped model
 @needs_llama
 @pytest.mark.parametrize("by", ["samples+edits", "edits"])
 def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by):

@@ -54,6 +54,7 @@ def test_finetuned_translates_sentences_it_never_saw(finetuned, llama_backend):
     assert tuned >= 5 and base <= 1, (tuned, base)
 
 
+@pytest.mark.slow  # 12 answers; the sentences it never saw test the shipped model's answers
 def test_an_untimed_sentence_comes_out_untimed(finetuned):
     """Tests that allowing time bounds by default does not invent them: untimed
     hand-written instructions get untimed answers."""
@@ -66,6 +67,7 @@ def test_an_untimed_sentence_comes_out_untimed(finetuned):
     assert all("[" not in a for a in answers), answers
 
 
+@pytest.mark.slow  # 24 answers; the sentences it never saw test the shipped model's accuracy
 def test_finetuned_translates_paper_pairs_with_and_without_worked_examples(finetuned,
                                                                           paper_split):
     """On lifted paper-split test pairs: zero-shot, and with 5 worked examples from the
@@ -94,7 +96,8 @@ def test_names_reach_every_shipped_adapter(finetuned, tmp_path):
         make_backend(f"lora:{tmp_path / 'missing.gguf'}")
 
 
-@pytest.mark.parametrize("by", ["samples+edits", "edits", "samples"])
+@pytest.mark.parametrize("by", [  # samples: another 9 answers, for the draws' count
+    "samples+edits", "edits", pytest.param("samples", marks=pytest.mark.slow)])
 def test_repair_puts_back_a_bound_the_sentence_states(finetuned, by):
     """Tests `ara translate`'s repair on a hand-written instruction whose greedy answer
     gives both pallets the later deadline: by edits, the model's best-scored answer of

@@ -19,6 +19,7 @@ def test_constrained_outputs_belong_to_the_language(hf_backend, paper_split):
         assert result.valid and translator.config.syntax(record.aps).accepts(result.stl), result
 
 
+@pytest.mark.slow  # loads a second model; llama.cpp's prefix reuse is tested in the default tier
 def test_prefix_reuse_gives_the_fresh_answer(hf_backend, hf_model_dir, paper_split):
     """Tests that cropping the cache to the shared prefix changes no answer."""
     from ara.eval.backends.hf_backend import HFBackend
@@ -53,6 +54,7 @@ def test_unknown_model_is_a_clear_error(tmp_path):
         HFBackend(str(tmp_path / "nothing-here"))
 
 
+@pytest.mark.slow  # each runtime's scoring is checked by the decoding-sum test
 def test_transformers_and_llama_cpp_score_answers_alike(hf_backend, llama_backend):
     """Tests one model's two runtimes against each other: the same answers get nearly
     the same log-probability (the HF folder is the GGUF's weights, dequantized)."""
@@ -85,6 +87,7 @@ def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backe
                                                    abs=0.5)
 
 
+@pytest.mark.slow  # loads a second model to score afresh
 def test_scores_shared_prefixes_change_only_float_rounding(hf_backend, hf_model_dir):
     """Tests that the transformers backend, which feeds answers after the prefix they
     share with the one before, scores each as a fresh model scoring it alone does, up

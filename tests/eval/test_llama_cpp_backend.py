@@ -38,6 +38,9 @@ def decoding_grammar(aps, **kwargs):
                                                    **kwargs)))
 
 
+# 20 answers: every constrained answer is checked against the grammar as it is made,
+# and the tests below generate under it in the default tier.
+@pytest.mark.slow
 def test_constrained_outputs_always_belong_to_the_language(llama_backend, paper_split):
     """Tests the guarantee on real generations: 0 and 5 shots, lifted and grounded,
     with and without the grammar in the prompt; every output is in the language."""
@@ -115,6 +118,7 @@ def test_prefix_reuse_changes_nothing_but_the_work(llama_backend, embedded_model
         assert (fresh[1], fresh[2]) == (drawn, scores)
 
 
+@pytest.mark.slow  # a second model load, under llama.cpp's grammar sampler (seconds an answer)
 def test_llguidance_and_llama_cpp_masks_choose_the_same_tokens(embedded_model_path,
                                                                llama_backend, paper_split):
     """Tests that the fast mask is exact: greedy decoding under llama.cpp's own grammar

@@ -82,6 +82,7 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
     assert vote.answers == (greedy.stl,)
 
 
+@pytest.mark.slow  # llama.cpp's grammar sampler over HTTP: seconds an answer
 def test_constrained_decoding_on_the_server_equals_the_local_backend(server, llama_backend,
                                                                       paper_split):
     """Tests F+P+C over HTTP: the request's grammar travels in llama.cpp's field, every
@@ -180,6 +181,7 @@ def test_a_live_server_decodes_under_the_grammar():
     assert result.valid and result.constrained
 
 
+@pytest.mark.slow  # two ablations over HTTP; the server's answers are tested above
 def test_concurrent_requests_keep_the_serial_log(server, tmp_path, llama_backend):
     """Tests --concurrency: with three requests in flight the samples are the serial
     run's, in the same order, a resumed run adds none twice, and a local backend

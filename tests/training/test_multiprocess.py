@@ -40,6 +40,7 @@ def _train(command: list[str], config: dict, folder, **env_extra) -> tuple[list[
     return [json.loads(line)["loss"] for line in log], processes
 
 
+@pytest.mark.slow  # trains in two processes and in one
 def test_two_processes_train_like_one_with_the_same_global_batch(tiny_gemma_dir, tmp_path):
     """Tests the multi-GPU path on CPUs: two processes (torchrun, gloo) split each batch
     of 4, log one line per step, and their losses equal a single process's on the
