@@ -56,7 +56,6 @@ def test_the_note_reads_the_answer_back():
         '  F(a) & F(b)  (probability 0.35): "eventually a, and eventually b"')
 
 
-@pytest.mark.slow  # test_hf_backend checks the same sum on llama.cpp and transformers
 def test_decoding_scores_its_answer_on_the_way(translator):
     """Tests that the log-probability decoding sums while it writes an answer is the
     one scoring the answer afterwards gives, so the check on every answer costs no

@@ -130,7 +130,6 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
         translate_repaired(t, nl, aps, doubt=2)
 
 
-@pytest.mark.slow  # test_finetuned's repair by samples+edits and edits runs it on the shipped model
 @needs_llama
 @pytest.mark.parametrize("by", ["samples+edits", "edits"])
 def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by):

@@ -54,7 +54,6 @@ def test_unknown_model_is_a_clear_error(tmp_path):
         HFBackend(str(tmp_path / "nothing-here"))
 
 
-@pytest.mark.slow  # each runtime's scoring is checked by the decoding-sum test
 def test_transformers_and_llama_cpp_score_answers_alike(hf_backend, llama_backend):
     """Tests one model's two runtimes against each other: the same answers get nearly
     the same log-probability (the HF folder is the GGUF's weights, dequantized)."""
