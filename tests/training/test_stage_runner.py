@@ -98,7 +98,9 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         "stage soup: started (soup)"]
     stages = record["stages"]
     assert set(stages) == {"start", "refine-a", "refine-b", "soup"}
-    assert all(s["wall_s"] > 0 and s["peak_rss_mb"] > 0 for s in stages.values())
+    assert all(s["wall_s"] >= 0 and s["peak_rss_mb"] > 0 for s in stages.values())
+    # A tiny soup can take less than the record's 0.1 s; training never does.
+    assert all(stages[name]["wall_s"] > 0 for name in ("start", "refine-a", "refine-b"))
     assert stages["refine-a"]["result"]["steps"] == 1
     soup = json.loads((out / "soup" / "run.json").read_text())
     assert soup["soup"]["rank"] == 8 and soup["reduced"]["rank"] == 4
