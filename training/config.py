@@ -27,10 +27,10 @@ def _build(cls, data: dict | None, where: str):
     return cls(**data)
 
 
-#: The shipped adapters in the PEFT form training starts from, by ``--model`` name. (The
-#: run chain's record keeps it until it moves beside the GGUF in ``eval/models/``.)
-SHIPPED_PEFT = {"finetuned": Path(__file__).parents[1] / "docs" / "results" / "training"
-                / "compositional-270m-soup-v16v17" / "adapter"}
+#: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
+#: by ``--model`` name, beside their GGUF.
+SHIPPED_PEFT = {"finetuned": Path(__file__).parents[1] / "eval" / "models"
+                / "gemma3-270m-nl2tl-lora-peft"}
 
 
 @dataclass(frozen=True)
