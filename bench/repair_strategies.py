@@ -42,6 +42,7 @@ from tqdm import tqdm
 
 from ara.data import load_or_prepare
 from ara.eval.backends.base import Sampling
+from ara.eval.checks import gaps
 from ara.eval.consistency import (
     _missing,
     literal_mends,
@@ -49,9 +50,9 @@ from ara.eval.consistency import (
     rank_scored,
     score_complete,
 )
-from ara.eval.coverage import gaps
 from ara.eval.harness import judge
 from ara.eval.models import make_backend
+from ara.eval.request import Request
 from ara.eval.translator import Translator
 from ara.grammars import parse
 
@@ -79,7 +80,8 @@ def gapped_rows(translator: Translator, split: str, form: str, limit: int,
     records = random.Random(0).sample(records, len(records))[:limit]
     rows = []
     for r in tqdm(records, desc="greedy answers", unit="pair"):
-        if 0 < _missing(r.nl, r.aps, translator.translate(r.nl, r.aps).stl) < float("inf"):
+        greedy = translator.translate(r.nl, r.aps).stl
+        if 0 < _missing(Request.of(r.nl, r.aps), greedy) < float("inf"):
             rows.append({"nl": r.nl, "aps": list(r.aps), "reference": r.stl})
     return rows
 
@@ -88,7 +90,8 @@ def candidates(translator: Translator, nl: str, aps: list[str], k: int,
                strategies: tuple[str, ...]) -> dict[str, list]:
     """Each strategy's answers, greedy first."""
     greedy = translator.translate(nl, aps).stl
-    gap = gaps(nl, aps, parse(greedy))
+    request = Request.of(nl, aps)
+    gap = gaps(request, parse(greedy))
     missing = (*gap.aps, *map(str, gap.numbers))
     draws = [translator.translate(nl, aps, sampling=Sampling(0.7, seed=i)).stl
              for i in range(1, k + 1)]
@@ -99,13 +102,13 @@ def candidates(translator: Translator, nl: str, aps: list[str], k: int,
                                              require=missing).stl for i in range(1, k + 1)]
         out |= {"forced": [greedy, forced], "forced+samples": [greedy, forced, *draws],
                 "forced samples": [greedy, *forced_draws]}
-    edits = literal_mends(translator, nl, aps, greedy)
+    edits = literal_mends(translator, request, greedy)
     return out | {"edits": [greedy, *edits], "samples+edits": [greedy, *draws, *edits]}
 
 
 def winner(translator: Translator, nl: str, aps: list[str], answers: list, scored: bool,
            timeout_s: float) -> str | None:
-    missing = [_missing(nl, aps, a) for a in answers]
+    missing = [_missing(Request.of(nl, aps), a) for a in answers]
     if not scored:
         return answers[rank_repairs(answers, missing, timeout_s)[0][0]]
     scores = score_complete(translator, nl, aps, answers, missing)

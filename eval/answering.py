@@ -16,6 +16,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ara.errors import ConfigError
+from ara.eval.checks import Gaps, gaps
 from ara.eval.confidence import DOUBT, doubt_warning, result_probability, winner_probability
 from ara.eval.consistency import (
     DEFAULT_REPAIR,
@@ -25,8 +26,8 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
-from ara.eval.coverage import Gaps, gaps
 from ara.eval.prompt import Shot, sample_shots
+from ara.eval.request import Request
 from ara.eval.translator import Translator
 from ara.grammars import parse
 
@@ -111,10 +112,10 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         :data:`DOUBT`); ``left_out`` (listed propositions and stated bounds the answer
         never uses; ``order``: whether it orders nothing where the sentence asks
         for one step after another; ``claims``: ``G``, ``F``, ``G(F)`` the sentence asks
-        for in words and the answer never writes, :func:`~ara.eval.coverage.unclaimed`)
+        for in words and the answer never writes, :func:`~ara.eval.checks.unclaimed`)
         and ``unasked`` (subformulas nesting temporal
         operators or ordering steps as the sentence never asks,
-        :func:`~ara.eval.coverage.unasked`), where the answer parses.
+        :func:`~ara.eval.checks.unasked`), where the answer parses.
     """
     config = config or AnswerConfig()
     vote: Vote | None = None
@@ -154,7 +155,7 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
                                              limit=1 + config.alternatives)[1:]]
     data["alternatives"] = [{"stl": stl, "probability": _significant(p)} for stl, p in others]
     if result.stl is not None:
-        data |= gaps(nl, aps, parse(result.stl)).to_json()
+        data |= gaps(Request.of(nl, aps), parse(result.stl)).to_json()
     return data
 
 
@@ -221,7 +222,7 @@ def notes(data: dict, nl: str = "") -> list[str]:
     said = []
     gap = Gaps.from_json(data)
     if gap:
-        said.append(gap.warning(nl))
+        said.append(gap.warning(Request.of(nl, ())))  # data lists no aps: read nl whole
     if doubted(data):
         others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
         said.append(doubt_warning(data["stl"], data["confidence"], others))

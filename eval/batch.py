@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ara.errors import AraError, ConfigError
 from ara.eval.answering import AnswerConfig, answer, doubted
-from ara.eval.coverage import Gaps
+from ara.eval.checks import Gaps
 from ara.eval.harness import judge
 from ara.eval.prompt import Shot
 from ara.eval.translator import Translator, TranslatorConfig, check_request

@@ -7,7 +7,7 @@ greedy answer, so with one sample this is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
 
 Repair (:func:`translate_repaired`) looks for another answer only when the greedy one
-leaves out a listed proposition or a stated bound (:mod:`ara.eval.coverage`), and then
+leaves out a listed proposition or a stated bound (:mod:`ara.eval.checks`), and then
 prefers the answers that leave out least; the greedy answer stays unless another says
 more of the request. By default the other answers are samples drawn under the grammar
 and the formulas one edit from the greedy one that write what it left out, and the
@@ -28,18 +28,12 @@ from dataclasses import dataclass, replace
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
+from ara.eval.checks import gaps, mends
 from ara.eval.confidence import DOUBT, result_score
-from ara.eval.coverage import gaps, unasked
 from ara.eval.prompt import Shot
+from ara.eval.request import Request
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
-from ara.grammars.literal_edits import (
-    chained,
-    claim_edits,
-    literal_edits,
-    operator_drops,
-    unchained,
-)
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. What
@@ -174,60 +168,60 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     if not 0 <= doubt <= 1:
         raise ConfigError(f"doubt is a probability, 0 to 1 (0: gaps only); got {doubt}")
     start = time.perf_counter()
+    request = Request.of(nl, aps)
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
     # Without intervals no answer can write a bound: only propositions can be mended.
     bounds = translator.config.intervals
-    gap = _missing(nl, aps, greedy.stl, bounds)
+    gap = _missing(request, greedy.stl, bounds)
     helpless = not translator.can_score and not getattr(translator.backend, "can_sample", True)
     if not samples or gap == float("inf") or helpless:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
     if not gap:
-        return _unless_doubted(translator, greedy, shots, samples, temperature, seed,
+        return _unless_doubted(translator, request, greedy, shots, samples, temperature, seed,
                                grammar_in_prompt, doubt if by == "samples+edits" else 0.0,
                                start)
     if by != "samples" and translator.can_score:
         drawn = (_draw(translator, nl, aps, shots, samples, temperature, seed,
                        grammar_in_prompt) if by == "samples+edits" else [])
-        mends = literal_mends(translator, nl, aps, greedy.stl, bounds)
-        if drawn or mends:
+        mended = literal_mends(translator, request, greedy.stl, bounds)
+        if drawn or mended:
             results = [greedy, *drawn, *(replace(greedy, raw=ANSWER_PREFIX + text, stl=text)
-                                         for text in mends)]
-            return _ranked_by_score(translator, results, shots, grammar_in_prompt,
+                                         for text in mended)]
+            return _ranked_by_score(translator, request, results, shots, grammar_in_prompt,
                                     greedy_stays=True, start=start)
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
                               grammar_in_prompt)]
     ranked = rank_repairs([r.stl for r in results],
-                          [_missing(nl, aps, r.stl, bounds) for r in results], timeout_s)
+                          [_missing(request, r.stl, bounds) for r in results], timeout_s)
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
-def _unless_doubted(translator: Translator, greedy: TranslationResult, shots: Sequence[Shot],
-                    samples: int, temperature: float, seed: int, grammar_in_prompt: bool,
-                    doubt: float, start: float) -> Vote:
+def _unless_doubted(translator: Translator, request: Request, greedy: TranslationResult,
+                    shots: Sequence[Shot], samples: int, temperature: float, seed: int,
+                    grammar_in_prompt: bool, doubt: float, start: float) -> Vote:
     """The complete greedy answer, with its score where the backend scores; if the model
     gives it a probability below ``doubt``, the best-scored of it and ``samples`` drawn
     answers that leave nothing out."""
-    nl, aps = greedy.nl, greedy.aps
     if not doubt or not translator.can_score:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
     score = result_score(translator, greedy, shots, grammar_in_prompt)  # decoding's, if any
     if math.exp(score) >= doubt:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
-    results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
-                              grammar_in_prompt)]
-    return _ranked_by_score(translator, results, shots, grammar_in_prompt,
+    results = [greedy, *_draw(translator, request.nl, request.aps, shots, samples,
+                              temperature, seed, grammar_in_prompt)]
+    return _ranked_by_score(translator, request, results, shots, grammar_in_prompt,
                             greedy_stays=False, start=start)
 
 
-def _ranked_by_score(translator: Translator, results: Sequence[TranslationResult],
-                     shots: Sequence[Shot], grammar_in_prompt: bool, greedy_stays: bool,
-                     start: float) -> Vote:
+def _ranked_by_score(translator: Translator, request: Request,
+                     results: Sequence[TranslationResult], shots: Sequence[Shot],
+                     grammar_in_prompt: bool, greedy_stays: bool, start: float) -> Vote:
     """A vote over ``results`` (greedy first) by the model's score of those that leave
     out least (:func:`score_complete`, :func:`rank_scored`), grouped by text."""
-    nl, aps = results[0].nl, results[0].aps
     answers = [r.stl for r in results]
-    missing = [_missing(nl, aps, a, translator.config.intervals) for a in answers]
-    scores = score_complete(translator, nl, aps, answers, missing, shots, grammar_in_prompt)
+    missing = [_missing(request, a, translator.config.intervals) for a in answers]
+    scores = score_complete(translator, request.nl, request.aps, answers, missing, shots,
+                            grammar_in_prompt)
     order = rank_scored(missing, scores, greedy_stays)
     return Vote(tuple(results), _same_text(results, order),
                 (time.perf_counter() - start) * 1e3, tuple(scores))
@@ -287,31 +281,14 @@ def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
     return ranked
 
 
-def literal_mends(translator: Translator, nl: str, aps: Sequence[str], stl: str,
+def literal_mends(translator: Translator, request: Request, stl: str,
                   bounds: bool = True) -> list[str]:
-    """Formulas one edit from ``stl`` that write something it leaves out of the request
-    (:func:`~ara.grammars.literal_edits.literal_edits`), drop a temporal operator the
-    sentence never asks for (:func:`~ara.grammars.literal_edits.operator_drops`, twice
-    where one drop leaves another), free steps it orders against "in any order"
-    (:func:`~ara.grammars.literal_edits.unchained`), or order steps the sentence puts
-    one after the other (:func:`~ara.grammars.literal_edits.chained`), or say what
-    the sentence asks to hold, happen or recur
-    (:func:`~ara.grammars.literal_edits.claim_edits`), kept to the
-    request's language so that each is an answer constrained decoding could have
+    """Formulas one edit from ``stl`` that close one of its gaps
+    (:func:`~ara.eval.checks.mends`; without ``bounds``, not a stated bound), kept to
+    the request's language so that each is an answer constrained decoding could have
     given."""
-    formula = parse(stl)
-    gap = gaps(nl, aps, formula)
-    syntax = translator.grammar(aps, nl).syntax
-    edits = literal_edits(formula, gap.aps, gap.numbers if bounds else ())
-    # An operator the sentence never asks for is dropped; where that leaves another
-    # (F[0,200](F(G(a))) drops to F[0,200](G(a))), that one is dropped too.
-    added = unasked(nl, formula)
-    drops = operator_drops(formula, added)
-    drops += [again for once in drops for again in operator_drops(once, unasked(nl, once))]
-    drops += unchained(formula, added)
-    chains = chained(formula) if gap.unordered else []
-    claims = claim_edits(formula, gap.claims)
-    texts = dict.fromkeys(map(to_text, [*edits, *drops, *chains, *claims]))
+    syntax = translator.grammar(request.aps, request.nl).syntax
+    texts = dict.fromkeys(map(to_text, mends(request, parse(stl), bounds)))
     texts.pop(stl, None)
     return [text for text in texts if syntax.accepts(text)]
 
@@ -324,12 +301,12 @@ def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[S
             for i in range(1, n + 1)]
 
 
-def _missing(nl: str, aps: Sequence[str], stl: str | None, bounds: bool = True) -> float:
+def _missing(request: Request, stl: str | None, bounds: bool = True) -> float:
     """How much of the request an answer leaves out (an unparsed one: everything);
     without ``bounds``, only the propositions count."""
     if stl is None:
         return float("inf")
-    gap = gaps(nl, aps, parse(stl))
+    gap = gaps(request, parse(stl))
     return len(gap) if bounds else len(gap.aps)
 
 

@@ -16,10 +16,13 @@ Spot check ran out of time are left out of accuracy and containment and counted.
 from __future__ import annotations
 
 import statistics
-from collections import defaultdict
+from collections import Counter, defaultdict
 from collections.abc import Iterable
 from typing import TypedDict
 
+from ara.eval.checks import KINDS, gaps
+from ara.eval.request import Request
+from ara.grammars import parse
 from ara.stats import describe
 
 
@@ -110,3 +113,30 @@ def overhead(results: list[VariantResult]) -> dict[str, float]:
             if base and (base, shots) in by_key and by_key[(base, shots)]:
                 ratios[f"{variant} / {base} @ {shots} shots"] = round(ms / by_key[(base, shots)], 3)
     return ratios
+
+
+def gap_precision(references: Iterable = (),
+                  answers: Iterable[dict] = ()) -> dict[str, Counter]:
+    """How often each kind of gap (:data:`~ara.eval.checks.KINDS`) flags a right answer,
+    and a wrong one: how precise the signal repair acts on is.
+
+    Args:
+        references: Pairs with ``nl``, ``aps`` and a reference ``stl``; each is a right
+            answer, so each one flagged is a right answer repair would try to mend.
+        answers: Sample lines of a run (``nl``, ``aps``, ``stl``, ``equivalent``); those
+            with no formula are skipped.
+
+    Returns:
+        Per kind, a count of ``references`` flagged, and of the ``right`` and ``wrong``
+        answers flagged.
+    """
+    counts = {kind: Counter() for kind in KINDS}
+    for r in references:
+        for kind in gaps(Request.of(r.nl, r.aps), parse(r.stl)).kinds():
+            counts[kind]["references"] += 1
+    for row in answers:
+        if row.get("stl"):
+            verdict = "right" if row["equivalent"] else "wrong"
+            for kind in gaps(Request.of(row["nl"], row["aps"]), parse(row["stl"])).kinds():
+                counts[kind][verdict] += 1
+    return counts

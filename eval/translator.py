@@ -17,6 +17,7 @@ from functools import lru_cache
 from ara.errors import AraError, ConfigError, STLSyntaxError
 from ara.eval.backends.base import Backend, BackendError, Sampling
 from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
+from ara.eval.request import Request
 from ara.grammars import (
     BuiltGrammar,
     Formula,
@@ -70,10 +71,10 @@ class TranslatorConfig:
 
     def syntax(self, aps: Sequence[str], nl: str | None = None) -> Syntax:
         """The language of one request: its propositions, and with ``nl`` under
-        ``bounds_from_request``, the numbers it writes."""
+        ``bounds_from_request``, the numbers it writes (:attr:`Request.numbers`)."""
         intervals, bounds = self.intervals, None
         if intervals and self.bounds_from_request and nl is not None:
-            numbers = {n for n in request_numbers(nl) if n <= self.max_bound}
+            numbers = {n for n in Request.of(nl, aps).numbers if n <= self.max_bound}
             intervals, bounds = bool(numbers), (tuple(numbers | {0}) if numbers else None)
         return Syntax(aps=tuple(aps), intervals=intervals, max_bound=self.max_bound,
                       bounds=bounds, max_depth=self.max_depth, max_args=self.max_args)
@@ -135,21 +136,6 @@ class RequestError(AraError, ValueError):
 
 
 _STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
-NUMBER_WORDS = {w: i for i, w in enumerate(
-    "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
-    "fifteen sixteen seventeen eighteen nineteen twenty".split())}
-NUMBER_WORDS |= {w: 10 * (i + 3) for i, w in enumerate(
-    "thirty forty fifty sixty seventy eighty ninety".split())} | {"hundred": 100}
-
-
-def _digit_numbers(nl: str) -> list[int]:
-    return [int(n) for n in re.findall(r"\d+", nl)]
-
-
-def request_numbers(nl: str) -> set[int]:
-    """The numbers an instruction writes, as digits or as words ("ten", "thirty")."""
-    words = re.findall(r"[a-z]+", nl.lower())
-    return set(_digit_numbers(nl)) | {NUMBER_WORDS[w] for w in words if w in NUMBER_WORDS}
 
 
 def mentions(nl: str, ap: str) -> bool:
@@ -177,7 +163,8 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
             f"the instruction {nl!r} never mentions {', '.join(unmentioned)}: each proposition "
             "in --aps must be named in the sentence (by its name or a word of it, e.g. "
             "go_to_kitchen by 'kitchen'); drop the others from --aps")
-    numbers = _digit_numbers(nl)  # digits only: the grammar drops number words above it
+    # digits only: the grammar drops number words above its largest bound
+    numbers = [int(n) for n in re.findall(r"\d+", nl)]
     if config.intervals and numbers and max(numbers) > config.max_bound:
         raise RequestError(
             f"the instruction mentions {max(numbers)}, above the grammar's largest time bound "

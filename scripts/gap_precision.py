@@ -1,17 +1,14 @@
-"""How precise each gap repair acts on is (:class:`ara.eval.coverage.Gaps`): how many
-references would read as leaving part of their sentence out (a right answer matches
-its reference, so each one is a right answer repair would wrongly try to mend), and,
-for a run of ``scripts/eval_generalization.sh``, how many flagged answers were right
-and how many wrong.
+"""How precise each gap repair acts on is (:func:`ara.eval.metrics.gap_precision`): how
+many references would read as leaving part of their sentence out (a right answer
+matches its reference, so each one is a right answer repair would wrongly try to mend),
+and, for a run of ``scripts/eval_generalization.sh``, how many flagged answers were
+right and how many wrong.
 
     .venv/bin/python scripts/gap_precision.py [--run RUN] [--variant C] [--json] [--show N]
 
 Sets: the three hand-written suites, the compositional test side, NL2TL's timed dev file,
 the paper split's test side, and the compositional training mixture (whose NL2TL labels
-are noisy). Kinds: ``aps`` and ``numbers`` (a listed proposition, a stated bound left
-out), ``unasked`` (operators nested or steps ordered unasked), ``order`` (an order asked
-for and not written), ``claims`` (what the sentence asks to hold, happen or recur and the
-formula never says).
+are noisy). Kinds: :data:`ara.eval.checks.KINDS`.
 """
 
 from __future__ import annotations
@@ -19,12 +16,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections import Counter
+from itertools import islice
 from pathlib import Path
 
 from ara.data import load_or_prepare
 from ara.data.handwritten import suite_records
-from ara.eval.coverage import KINDS, gaps
+from ara.eval.checks import KINDS, gaps
+from ara.eval.metrics import gap_precision
+from ara.eval.request import Request
 from ara.grammars import parse
 
 RESULTS = Path("docs/results/generalization")
@@ -41,31 +40,11 @@ def reference_sets() -> dict[str, list]:
             "training mixture": compositional.records("train")}
 
 
-def flagged_references(records: list, show: int) -> tuple[Counter, list[str]]:
-    counts: Counter = Counter()
-    shown = []
-    for r in records:
-        kinds = gaps(r.nl, r.aps, parse(r.stl)).kinds()
-        counts.update(kinds)
-        if kinds and len(shown) < show:
-            shown.append(f"{'/'.join(kinds)}: {r.nl} -> {r.stl}")
-    return counts, shown
-
-
-def flagged_answers(run: Path, variant: str) -> dict[str, dict[str, Counter]]:
-    """Per set of the run, per kind, how many flagged answers were right and wrong."""
-    out: dict[str, dict[str, Counter]] = {}
-    for samples in sorted([*run.glob("samples.jsonl"), *run.glob("*/samples.jsonl")]):
-        per_kind: dict[str, Counter] = {kind: Counter() for kind in KINDS}
-        for line in samples.read_text().splitlines():
-            row = json.loads(line)
-            if row.get("variant") != variant or not row.get("stl"):
-                continue
-            verdict = "right" if row["equivalent"] else "wrong"
-            for kind in gaps(row["nl"], row["aps"], parse(row["stl"])).kinds():
-                per_kind[kind][verdict] += 1
-        out[samples.parent.name] = per_kind
-    return out
+def run_answers(run: Path, variant: str) -> dict[str, list[dict]]:
+    """Per set of the run (a folder of ``samples.jsonl``), the answers of ``variant``."""
+    return {samples.parent.name: [row for row in map(json.loads, samples.read_text().splitlines())
+                                  if row.get("variant") == variant]
+            for samples in sorted([*run.glob("samples.jsonl"), *run.glob("*/samples.jsonl")])}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -86,14 +65,18 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"no run folder {args.run} (nor {RESULTS / args.run})")
     references = {}
     for name, records in reference_sets().items():
-        counts, shown = flagged_references(records, args.show)
-        references[name] = {"references": len(records), **{k: counts[k] for k in KINDS}}
-        for line in shown:
-            print(f"  {name}: {line}", file=sys.stderr)
-    answers = flagged_answers(run, args.variant) if run else {}
+        counts = gap_precision(records)
+        references[name] = {"references": len(records),
+                            **{k: counts[k]["references"] for k in KINDS}}
+        flagged = ((r, gaps(Request.of(r.nl, r.aps), parse(r.stl)).kinds()) for r in records)
+        for r, kinds in islice(((r, k) for r, k in flagged if k), args.show):
+            print(f"  {name}: {'/'.join(kinds)}: {r.nl} -> {r.stl}", file=sys.stderr)
+    answers = {name: gap_precision(answers=rows)
+               for name, rows in (run_answers(run, args.variant) if run else {}).items()}
     if args.json:
         print(json.dumps({"references": references,
-                          "answers": {s: {k: dict(c) for k, c in per.items()}
+                          "answers": {s: {k: dict(c)
+                                          for k, c in per.items()}
                                       for s, per in answers.items()}}, indent=1))
         return 0
     print("References a check flags (each is a right answer repair would act on):\n")

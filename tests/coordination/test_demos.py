@@ -5,8 +5,9 @@ import json
 import pytest
 
 from ara.coordination.demos import ERRANDS, run_demo
+from ara.eval.checks import gaps
 from ara.eval.confidence import DOUBT
-from ara.eval.coverage import gaps
+from ara.eval.request import Request
 from ara.eval.translator import Translator
 from ara.grammars import parse
 
@@ -24,7 +25,7 @@ def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path, 
     errand = ERRANDS[name]
     assert result["source"].startswith("translated by gguf:")
     assert any(line.startswith("[STL, translated by") for line in lines)
-    left_out = gaps(errand.nl, tuple(errand.places), parse(result["stl"]))
+    left_out = gaps(Request.of(errand.nl, errand.places), parse(result["stl"]))
     assert any(line.startswith("warning:") for line in lines) == bool(left_out)
     assert 0 < result["confidence"] <= 1  # the model's probability of the formula planned
     assert any(line.startswith("note:") for line in lines) == (result["confidence"] < DOUBT)

@@ -8,6 +8,7 @@ import pytest
 
 from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
+from ara.eval.checks import gaps
 from ara.eval.consistency import (
     Vote,
     _group,
@@ -17,7 +18,7 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
-from ara.eval.coverage import gaps
+from ara.eval.request import Request
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
 
@@ -114,11 +115,11 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     aps = ("prop_1", "prop_2")
     nl = "within 20 steps reach (prop_1), and never (prop_2)"
     greedy = t.translate(nl, aps)
-    greedy_gaps = len(gaps(nl, aps, parse(greedy.stl)))
+    greedy_gaps = len(gaps(Request.of(nl, aps), parse(greedy.stl)))
     vote = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
     assert vote.answers[0] == greedy.stl
     assert len(vote.results) == (4 if greedy_gaps else 1)
-    assert len(gaps(nl, aps, parse(vote.result.stl))) <= greedy_gaps
+    assert len(gaps(Request.of(nl, aps), parse(vote.result.stl))) <= greedy_gaps
     again = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
     assert (again.answers, again.groups) == (vote.answers, vote.groups)
     assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
@@ -141,14 +142,14 @@ def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by
     aps = ("prop_1", "prop_2")
     nl = "within 20 steps reach (prop_1), and never (prop_2)"
     greedy = t.translate(nl, aps)
-    left_out = gaps(nl, aps, parse(greedy.stl))
+    left_out = gaps(Request.of(nl, aps), parse(greedy.stl))
     if not left_out:
         pytest.skip(f"the greedy answer {greedy.stl} leaves nothing out")
     vote = translate_repaired(t, nl, aps, samples=3, by=by)
-    mends = literal_mends(t, nl, aps, greedy.stl)
+    mends = literal_mends(t, Request.of(nl, aps), greedy.stl)
     drawn = 3 if by == "samples+edits" else 0
     assert vote.answers[0] == greedy.stl and vote.answers[1 + drawn:] == tuple(mends)
-    missing = [len(gaps(nl, aps, parse(a))) for a in vote.answers]
+    missing = [len(gaps(Request.of(nl, aps), parse(a))) for a in vote.answers]
     scored = [i for i, x in enumerate(vote.scores) if x is not None]
     assert scored == [i for i, m in enumerate(missing) if m == min(missing)]
     winner = vote.groups[0][0]
@@ -167,12 +168,12 @@ def test_mends_drop_the_operators_a_sentence_never_asks_for(llama_backend):
     each is dropped, the second after the first, and nothing else is proposed."""
     t = Translator(llama_backend)
     nl, aps = "Reach the dock within 200 steps.", ("at_dock",)
-    assert gaps(nl, aps, parse("F[0,200](F(G(at_dock)))")).unasked == (
+    assert gaps(Request.of(nl, aps), parse("F[0,200](F(G(at_dock)))")).unasked == (
         "F[0,200](F(G(at_dock)))", "F(G(at_dock))")
-    mends = literal_mends(t, nl, aps, "F[0,200](F(G(at_dock)))")
+    mends = literal_mends(t, Request.of(nl, aps), "F[0,200](F(G(at_dock)))")
     assert {"F[0,200](at_dock)", "F[0,200](G(at_dock))", "F(G(at_dock))"} <= set(mends)
     assert "F[0,200](F(G(at_dock)))" not in mends
-    assert literal_mends(t, nl, aps, "F[0,200](at_dock)") == []
+    assert literal_mends(t, Request.of(nl, aps), "F[0,200](at_dock)") == []
 
 
 @needs_llama
@@ -180,11 +181,12 @@ def test_mends_order_steps_the_sentence_orders_and_free_those_it_does_not(llama_
     """Tests the mends of an answer that misses the order of its steps either way."""
     t = Translator(llama_backend)
     nl, aps = "Charge the battery, and afterwards return to the dock.", ("charge", "at_dock")
-    assert "F(charge & F(at_dock))" in literal_mends(t, nl, aps, "F(charge) & F(at_dock)")
+    mends = literal_mends(t, Request.of(nl, aps), "F(charge) & F(at_dock)")
+    assert "F(charge & F(at_dock))" in mends
     nl = "Water the plants and feed the cat, in either order."
     aps = ("water_plants", "feed_cat")
     assert "F(water_plants) & F(feed_cat)" in literal_mends(
-        t, nl, aps, "F(water_plants & F(feed_cat))")
+        t, Request.of(nl, aps), "F(water_plants & F(feed_cat))")
 
 
 @needs_llama
@@ -194,7 +196,7 @@ def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
     t = Translator(llama_backend, TranslatorConfig(intervals=False))
     nl, aps = "reach (prop_1) within 5 steps", ("prop_1",)
     vote = translate_repaired(t, nl, aps, samples=3, doubt=0)  # gaps only
-    left_out = gaps(nl, aps, parse(vote.answers[0]))
+    left_out = gaps(Request.of(nl, aps), parse(vote.answers[0]))
     assert left_out.numbers == (5,)
     assert len(vote.results) == (4 if left_out.aps else 1)
 
@@ -209,7 +211,7 @@ def test_repair_searches_again_only_where_the_model_doubts_a_complete_answer(fin
     assert sure.answers == ("G(!prop_1)",) and math.exp(sure.scores[0]) > 0.9
     nl, aps = "( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2")
     doubted = translate_repaired(t, nl, aps, samples=4, doubt=0.5)
-    assert len(doubted.answers) == 5 and not gaps(nl, aps, parse(doubted.answers[0]))
+    assert len(doubted.answers) == 5 and not gaps(Request.of(nl, aps), parse(doubted.answers[0]))
     assert math.exp(doubted.scores[0]) < 0.5
     best = max(s for s in doubted.scores if s is not None)
     assert doubted.scores[doubted.groups[0][0]] == best >= doubted.scores[0]

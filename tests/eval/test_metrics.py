@@ -1,10 +1,16 @@
 """The paper's metrics on hand-made sample sets with known answers."""
 
+import json
 import math
+from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
-from ara.eval.metrics import overhead, score
+from ara.data.handwritten import suite_records
+from ara.eval.metrics import gap_precision, overhead, score
+
+RESULTS = Path(__file__).parents[2] / "docs" / "results"
 
 
 def sample(variant, uid, valid, equivalent=None, implies=None, rerun=0, shots=5, ms=100.0):
@@ -67,3 +73,17 @@ def test_overhead_pairs_each_constrained_variant_with_its_twin():
     """Tests the latency ratio F+P+C / F+P."""
     samples = [sample("F+P", "a", True, True, ms=200.0), sample("F+P+C", "a", True, True, ms=210.0)]
     assert overhead(score(samples)) == {"F+P+C / F+P @ 5 shots": 1.05}
+
+
+def test_gap_precision_counts_flagged_references_and_right_or_wrong_answers():
+    """Tests gap precision on the hand-written suite's references, which no check flags,
+    on a stored run's answers, of which three are flagged and all wrong, and on a
+    reference flagged, which counts as a right answer repair would act on."""
+    assert not any(gap_precision(suite_records("handwritten")).values())
+    run = RESULTS / "generalization/hw4-greedy/handwritten4-lifted/samples.jsonl"
+    answers = [json.loads(line) for line in run.read_text().splitlines()]
+    counts = gap_precision(answers=answers)
+    assert counts["claims"] == {"wrong": 2} and counts["numbers"] == {"wrong": 1}
+    assert not counts["aps"] + counts["unasked"] + counts["order"]
+    stay = SimpleNamespace(nl="Go to the dock and stay there.", aps=["at_dock"], stl="F(at_dock)")
+    assert gap_precision([stay])["claims"] == {"references": 1}

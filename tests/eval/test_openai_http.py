@@ -66,8 +66,9 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
     """Tests that scoring answers, which repair ranks by, is refused by name on a
     server, and that repair, which can neither score nor sample there, keeps the
     greedy answer of a request it would repair on a local model."""
+    from ara.eval.checks import gaps
     from ara.eval.consistency import translate_repaired
-    from ara.eval.coverage import gaps
+    from ara.eval.request import Request
     from ara.grammars import parse
 
     translator = Translator(OpenAIBackend(server, server="llama"))
@@ -76,7 +77,7 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
         translator.score("eventually (prop_1)", ["prop_1"], [parse("F(prop_1)")])
     nl, aps = "within 20 steps reach (prop_1), and never (prop_2)", ("prop_1", "prop_2")
     greedy = translator.translate(nl, aps)
-    if not gaps(nl, aps, parse(greedy.stl)):
+    if not gaps(Request.of(nl, aps), parse(greedy.stl)):
         pytest.skip(f"the greedy answer {greedy.stl} leaves nothing out")
     vote = translate_repaired(translator, nl, aps)
     assert vote.answers == (greedy.stl,)

@@ -3,15 +3,9 @@
 import pytest
 
 from ara.data import load_or_prepare
-from ara.eval.translator import TranslatorConfig, decoding_grammar, request_numbers
+from ara.eval.translator import TranslatorConfig, decoding_grammar
 from ara.grammars import build_grammar
 from ara.grammars.ast import walk
-
-
-def test_numbers_are_read_as_digits_and_as_words():
-    assert request_numbers("within 20 steps reach the door, then wait ten") == {20, 10}
-    assert request_numbers("Pick up the pallet at (3, 4)") == {3, 4}
-    assert request_numbers("always avoid the door") == set()
 
 
 def test_a_sentence_without_numbers_gets_no_interval_at_all():

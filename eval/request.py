@@ -1,0 +1,113 @@
+"""A request analysed once: everything the grammar and the checks of an answer read
+from its sentence (:mod:`ara.grammars.cues`), so that no candidate answer re-reads it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+from ara.grammars.cues import (
+    ANY_ORDER_WORDS,
+    CLAIM_WORDS,
+    NESTING_WORDS,
+    NUMBER_WORDS,
+    TIME_WORDS,
+    says_in_order,
+)
+
+_LIFTED = re.compile(r"prop_\d+")
+
+
+@dataclass(frozen=True)
+class Request:
+    """One sentence and its propositions, with what its words ask for.
+
+    Attributes:
+        nl: The sentence.
+        aps: Its propositions, as listed.
+        numbers: Every number it writes, in digits or words: the bounds its grammar
+            may use (:meth:`~ara.eval.translator.TranslatorConfig.syntax`).
+        stated: The numbers it states as time (:func:`stated_numbers`): the bounds an
+            answer has to write.
+        claims: What it asks in words to hold, happen or recur, in the order of
+            :data:`~ara.grammars.cues.CLAIM_WORDS`; words that name a proposition
+            ("keep apple" for ``keep_apple``) ask for none.
+        claim_words: The first words asking for each of ``claims``.
+        allows: The nested pairs of ``F`` and ``G`` its words allow
+            (:data:`~ara.grammars.cues.NESTING_WORDS`).
+        ordered: Whether it puts one step after another.
+        any_order: Whether it lets its steps come in any order.
+    """
+
+    nl: str
+    aps: tuple[str, ...]
+    numbers: frozenset[int] = frozenset()
+    stated: frozenset[int] = frozenset()
+    claims: tuple[str, ...] = ()
+    claim_words: tuple[str, ...] = ()
+    allows: frozenset[str] = frozenset()
+    ordered: bool = False
+    any_order: bool = False
+
+    @classmethod
+    def of(cls, nl: str, aps: Sequence[str]) -> Request:
+        """``nl`` over ``aps`` analysed; the same request again is not read twice (the
+        translator's grammar and scoring ask for it per candidate answer)."""
+        return _analysed(nl, tuple(aps))
+
+    def asking_word(self, claim: str) -> str | None:
+        """The first words that ask for ``claim`` ("stay" for ``G``), if it is asked."""
+        return dict(zip(self.claims, self.claim_words, strict=True)).get(claim)
+
+
+@lru_cache(maxsize=1024)
+def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
+    # The nesting and order cues read the sentence whole, the claims with the words of a
+    # name blanked, the numbers with whole names blanked: each as its lists were tuned.
+    text, unnamed = nl.lower(), _unnamed(nl, aps)
+    found = [(claim, m.group(0)) for claim, words in CLAIM_WORDS.items()
+             if (m := words.search(unnamed))]
+    return Request(nl=nl, aps=aps, numbers=frozenset(written_numbers(nl)),
+                   stated=stated_numbers(nl, aps),
+                   claims=tuple(claim for claim, _ in found),
+                   claim_words=tuple(word for _, word in found),
+                   allows=frozenset(pair for pair, words in NESTING_WORDS.items()
+                                    if words.search(text)),
+                   ordered=says_in_order(text),
+                   any_order=ANY_ORDER_WORDS.search(text) is not None)
+
+
+def written_numbers(nl: str) -> set[int]:
+    """The numbers ``nl`` writes, as digits or as words ("ten", "thirty")."""
+    words = re.findall(r"[a-z]+", nl.lower())
+    return {int(n) for n in re.findall(r"\d+", nl)} | {NUMBER_WORDS[w] for w in words
+                                                       if w in NUMBER_WORDS}
+
+
+def stated_numbers(nl: str, aps: Sequence[str]) -> frozenset[int]:
+    """The numbers ``nl`` states as time: every number in digits, and a number word
+    next to a word of time ("ten steps", "step ten", "five more seconds"), less the
+    numbers that belong to a proposition (``prop_2`` written out, the 8 of "pallet 8"
+    when a proposition is ``deliver_pallet_8``). "At least one of", "one after the
+    other" and "the two together" state no bound."""
+    text = _LIFTED.sub(" ", nl.lower())
+    for ap in aps:
+        text = re.sub(rf"\b{re.escape(ap.lower())}\b", " ", text)
+    named = {int(n) for ap in aps if not _LIFTED.fullmatch(ap) for n in re.findall(r"\d+", ap)}
+    tokens = re.findall(r"[a-z]+|\d+", text)
+    numbers = {int(t) for t in tokens if t.isdigit()}
+    for i, t in enumerate(tokens):
+        if t in NUMBER_WORDS and TIME_WORDS & set(tokens[max(i - 1, 0):i] + tokens[i + 1:i + 3]):
+            numbers.add(NUMBER_WORDS[t])
+    return frozenset(numbers - named)
+
+
+def _unnamed(nl: str, aps: Sequence[str]) -> str:
+    """``nl`` in lower case with the words that spell a proposition's name blanked."""
+    text = nl.lower()
+    for ap in aps:
+        text = re.sub(rf"\b{re.escape(ap.lower().replace('_', ' '))}\b", " ", text)
+    return text

@@ -1,0 +1,90 @@
+"""The words by which a sentence asks for a construct, beside the realizer's phrasings
+for it (:mod:`ara.grammars.english`), which they must recognise.
+
+Each list holds the words that ask for its construct whatever the rest of the sentence
+says; "whenever", "within" and "during" can mean either of ``F`` and ``G`` and are in
+none. The lists read a sentence in lower case.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, HAPPENS, HOLDS
+
+#: Numbers a sentence may write in words.
+NUMBER_WORDS = {w: i for i, w in enumerate(
+    "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
+    "fifteen sixteen seventeen eighteen nineteen twenty".split())}
+NUMBER_WORDS |= {w: 10 * (i + 3) for i, w in enumerate(
+    "thirty forty fifty sixty seventy eighty ninety".split())} | {"hundred": 100}
+#: Words next to which a number word is a time ("ten steps", "step ten").
+TIME_WORDS = frozenset("step steps time second seconds minute minutes hour hours unit units "
+                       "tick ticks instant instants moment moments".split())
+
+#: Words that allow ``G(F(a))``: a again and again.
+AGAIN_AND_AGAIN_WORDS = re.compile(
+    r"\b(again|repeatedly|over and over|time and again|infinitely|often|periodic\w*"
+    r"|regularly|every so often|now and then|from time to time|always eventually"
+    r"|keep (?:on )?(?:visiting|revisiting|coming|returning|going|checking|patrolling"
+    r"|circling|cycling)|back and forth|patrol\w*|alternat\w*|recurr\w*|endless\w*"
+    r"|cycl\w*|loop\w*|round|never stops?|continual\w*|routine\w*)\b")
+#: Words that say something lasts: they ask for it to hold (:data:`HOLDS_WORDS`) and
+#: allow it from some point on, for good (:data:`FOR_GOOD_WORDS`).
+_LASTING = r"always|at all times|forever|for good|permanently|keep|remain|remains|remaining"
+#: Words that allow ``F(G(a))``: a from some point on, for good.
+FOR_GOOD_WORDS = re.compile(
+    rf"\b({_LASTING}|stay|stays|staying"
+    r"|from (?:then|now|there) on|from (?:that|this|the|some) (?:moment|point|time|step) on"
+    r"|eventually always|thereafter|ever after|onwards?|henceforth|indefinitely|in the end"
+    r"|ultimately|ends? up|settles?|continu\w*"
+    r"|uninterrupted\w*|consecutive\w*|consistently|(?:until|till) the (?:very )?end)\b")
+#: Words that order steps: "go to the dock, then charge". A ", then" after a condition
+#: ("if a, then b") orders nothing, nor does "sooner or later".
+SEQUENCE_WORDS = re.compile(
+    r"\b(and then|after that|afterwards?|followed by|one after the other|in (?:that|this) order"
+    r"|subsequently|(?<!no )(?<!sooner or )later)\b")
+THEN = re.compile(r"[,;] then\b")
+CONDITION_WORDS = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|provided"
+                             r"|as soon as|once|while|on condition|every ?time|each time)\b")
+#: Words that ask for no order between steps.
+ANY_ORDER_WORDS = re.compile(
+    r"\b(in (?:any|either|whatever|whichever) order|(?:the )?order does not matter"
+    r"|regardless of (?:the )?order|no matter (?:the|what|which) order)\b")
+#: Words that ask for something to hold over a stretch of time (:data:`HOLDS`). "Stay
+#: still" and "stay at the kitchen" name propositions in the realizer's words (``wait``,
+#: ``at_kitchen``), and "a or b, never both" is an exclusive or, so those ask nothing.
+HOLDS_WORDS = re.compile(
+    rf"\b({_LASTING}|all the time|never(?! both)|at no time"
+    r"|constantly|continuously|throughout|every ?time|each time|keeps|keeping"
+    r"|(?:stay|stays|staying)(?! still| at)|avoid\w*|until|till"
+    r"|for (?:the )?(?:next |first |whole |entire )?(?:\d+|[a-z]+ (?:steps|seconds|minutes)))\b")
+#: Words that ask for something to happen at some point (:data:`HAPPENS`).
+HAPPENS_WORDS = re.compile(
+    r"\b(eventually|at some (?:point|time|moment|step)|sooner or later|at least once"
+    r"|sometime|someday|ultimately|finally|in the end|at one point"
+    r"|(?:by|no later than|before) (?:step|time) \d+)\b")
+#: Words that ask for something again and again (:data:`AGAIN_AND_AGAIN`), a strict
+#: part of :data:`AGAIN_AND_AGAIN_WORDS`: each of these says it, not only allows it.
+RECURRING_WORDS = re.compile(
+    r"\b(again and again|repeatedly|over and over|time and again|infinitely often"
+    r"|every so often|now and then|from time to time|periodically|regularly"
+    r"|keep (?:on )?(?:visiting|revisiting|coming back|returning|going back|checking"
+    r"|patrolling|circling|cycling)|patrol\w*|back and forth"
+    r"|(?:at least )?once (?:in )?every|in every [\w-]+ (?:window|period|interval))\b")
+
+#: The words that ask for each temporal claim, in the order claims are reported.
+CLAIM_WORDS = {HOLDS: HOLDS_WORDS, HAPPENS: HAPPENS_WORDS, AGAIN_AND_AGAIN: RECURRING_WORDS}
+#: The words that allow each nested pair of ``F`` and ``G``.
+NESTING_WORDS = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS}
+
+
+def says_in_order(text: str) -> bool:
+    """Whether ``text`` puts one step after another: a word of order, or a ", then" not
+    ending a condition, unless it also says "in any order"."""
+    if ANY_ORDER_WORDS.search(text):
+        return False
+    if SEQUENCE_WORDS.search(text):
+        return True
+    then = THEN.search(text)
+    return then is not None and not CONDITION_WORDS.search(text[:then.start()])

@@ -1,0 +1,143 @@
+"""What an answer leaves out of its request, and adds unasked: the signals repair acts on."""
+
+from dataclasses import fields
+
+from ara.data.synthetic import synthetic_records
+from ara.eval.checks import CHECKS, KINDS, Gaps, gaps, mends, unasked, unclaimed
+from ara.eval.request import Request
+from ara.grammars import parse, to_text
+from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, RESTATED, nested_pairs
+
+
+def _gaps(nl, aps, stl):
+    return gaps(Request.of(nl, aps), parse(stl))
+
+
+def test_a_dropped_bound_and_a_dropped_proposition_are_gaps():
+    """Tests that a listed proposition and a stated bound no answer writes are gaps."""
+    nl = "At some point go to the kitchen, never go to the garage, and charge within 20 steps."
+    aps = ["go_to_kitchen", "go_to_garage", "charge"]
+    # "never" asks for something to hold over time, which neither F says
+    assert _gaps(nl, aps, "F(go_to_kitchen) & F(charge)") == Gaps(
+        aps=("go_to_garage",), numbers=(20,), claims=("G",))
+    assert not _gaps(nl, aps, "F(go_to_kitchen) & G(!go_to_garage) & F[0,20](charge)")
+
+
+def test_numbers_that_name_a_proposition_and_both_ends_of_an_interval_count():
+    """Tests that the 8 of "pallet 8" is no bound and either end of an interval writes one."""
+    nl = "Bring pallet 8 to the loading dock within 250 steps."
+    assert _gaps(nl, ["deliver_pallet_8"], "F[0,250](deliver_pallet_8)") == Gaps()
+    nl = "keep ( prop_1 ) between step ten and step 30"
+    assert _gaps(nl, ["prop_1"], "G[10,30](prop_1)") == Gaps()
+    assert _gaps(nl, ["prop_1"], "G[0,30](prop_1)").numbers == (10,)
+
+
+def test_an_untimed_request_with_every_proposition_has_no_gap():
+    """Tests that a gap counts one per thing left out."""
+    nl = "( prop_1 ) or ( prop_2 ) at some point"
+    assert len(_gaps(nl, ["prop_1", "prop_2"], "F(prop_1 | prop_2)")) == 0
+    assert len(_gaps(nl, ["prop_1", "prop_2"], "F(prop_1)")) == 1
+
+
+def test_nesting_the_sentence_never_asks_for_is_a_gap():
+    """Tests that "always keep a firm grip" asks for no grip again and again, and
+    "reach the garden" for no staying there."""
+    grip = _gaps("Always keep a firm grip on the bottle.", ["grip_bottle"], "G(F(grip_bottle))")
+    assert grip == Gaps(unasked=("G(F(grip_bottle))",))
+    assert "G(F(grip_bottle)) (again and again)" in grip.warning()
+    answer = parse("G(!at_stairs) & F(G(at_garden))")
+    keep = Request.of("Keep away from the stairs and eventually reach the garden.", ())
+    assert unasked(keep, answer) == ()  # "keep": for good
+    avoid = Request.of("Avoid the stairs and reach the garden.", ())
+    assert [to_text(f) for f in unasked(avoid, answer)] == ["F(G(at_garden))"]
+
+
+def test_words_for_a_pair_license_it_and_a_restated_operator_never_is():
+    """Tests that "every so often" and "stay there" license their pairs; F in F never."""
+    assert not _gaps("Inspect the forklift every so often.", ["inspect_forklift"],
+                     "G(F(inspect_forklift))")
+    assert not _gaps("Go to the charging station and stay there.", ["at_charging_station"],
+                     "F(G(at_charging_station))")
+    nl = "between time 10 and time 25, (prop_1) must happen at least once"
+    assert _gaps(nl, ["prop_1"], "F[10,25](F(prop_1))").unasked == ("F[10,25](F(prop_1))",)
+    assert not _gaps(nl, ["prop_1"], "F[10,25](prop_1)")
+
+
+def test_generated_sentences_never_ask_for_less_than_their_formula_says():
+    """Tests that no realized sentence reads as not asking for its formula's nesting or
+    order: repair must not undo what the model learned from them."""
+    for record in synthetic_records(300, seed=3, held_out=False):
+        formula, request = parse(record.stl), Request.of(record.nl, record.aps)
+        kinds = {next(nested_pairs(node), (None, "order"))[1]
+                 for node in unasked(request, formula)}
+        assert kinds <= {RESTATED}, (record.nl, record.stl)  # random draws restate
+        assert not gaps(request, formula).order, (record.nl, record.stl)
+
+
+def test_an_order_asked_for_and_one_never_asked_for_are_gaps():
+    """Tests both ways of getting order wrong."""
+    nl = "Go to the mailroom, then the gym."
+    aps = ["go_to_mailroom", "go_to_gym"]
+    assert _gaps(nl, aps, "F(go_to_mailroom) & F(go_to_gym)") == Gaps(order=True)
+    assert not _gaps(nl, aps, "F(go_to_mailroom & F(go_to_gym))")
+    assert "orders nothing in time" in Gaps(order=True).warning()
+    nl = "Visit the mailroom and the gym, in any order."
+    assert _gaps(nl, aps, "F(go_to_mailroom & F(go_to_gym))").unasked == (
+        "F(go_to_mailroom & F(go_to_gym))",)
+    assert not _gaps(nl, aps, "F(go_to_mailroom) & F(go_to_gym)")
+
+
+def test_what_the_sentence_asks_to_hold_happen_or_recur_and_the_answer_never_says():
+    """Tests claims left out, and the warning quoting the words that ask for them."""
+    nl = "Between step 10 and step 20, keep the door locked."
+    assert _gaps(nl, ["door_locked"], "F[10,20](door_locked)") == Gaps(claims=(HOLDS,))
+    assert not _gaps(nl, ["door_locked"], "G[10,20](door_locked)")
+    nl = "Do not enter the loading bay during the first 20 seconds, but enter it at some point."
+    request = Request.of(nl, ["enter_loading_bay"])
+    assert unclaimed(request, parse("G[0,20](!enter_loading_bay)")) == (HAPPENS,)
+    nl = "Inspect the forklift every so often."
+    request = Request.of(nl, ["inspect_forklift"])
+    assert unclaimed(request, parse("G(inspect_forklift)")) == (AGAIN_AND_AGAIN,)
+    slip = gaps(request, parse("G(inspect_forklift)"))
+    assert "never says that anything happens again and again (G(F)), as the sentence asks" in (
+        slip.warning())
+    assert ('never says that anything happens again and again (G(F)), which "every so often" '
+            "asks for") in slip.warning(request)
+    # "never" is read through negations: !F(a) says G(!a)
+    assert not unclaimed(Request.of("Never enter the lab.", ["enter_lab"]), parse("!F(enter_lab)"))
+
+
+def test_generated_sentences_never_ask_for_a_claim_their_formula_lacks():
+    """Tests that repair cannot undo what the model learned from the realizer's sentences."""
+    for record in synthetic_records(600, seed=5, held_out=False):
+        assert not unclaimed(Request.of(record.nl, record.aps), parse(record.stl)), (
+            record.nl, record.stl)
+
+
+def test_mends_close_the_gap_of_their_kind():
+    """Tests that each kind's mends write what was left out or drop what was added."""
+    request = Request.of("Charge, then reach the dock within 9 steps.", ("charge", "at_dock"))
+    assert {"F(charge & F(at_dock))",  # order: the steps chained
+            "F(charge) & F[0,9](at_dock)"} <= {  # numbers: the bound written
+        to_text(f) for f in mends(request, parse("F(charge) & F(at_dock)"))}
+    restated = parse("F(charge & F(F(at_dock)))")
+    assert "F(charge & F(at_dock))" in map(to_text, mends(request, restated))  # unasked
+    assert not any("9" in to_text(f) for f in mends(request, restated, timed=False))
+
+
+def test_each_kind_is_one_check_and_one_field_of_gaps():
+    """Tests that the registry and the record of gaps name the same kinds, in order."""
+    assert KINDS == ("aps", "numbers", "unasked", "order", "claims")
+    assert KINDS == tuple(check.kind for check in CHECKS) == tuple(f.name for f in fields(Gaps))
+
+
+def test_kinds_of_a_gap_in_a_fixed_order_and_its_json_round_trip():
+    """Tests the --json shape of a gap and that it reads back."""
+    gap = Gaps(aps=("a",), unasked=("G(F(b))",), order=True, claims=("G",))
+    assert gap.kinds() == ["aps", "unasked", "order", "claims"]
+    assert gap.to_json() == {"left_out": {"aps": ["a"], "numbers": [], "order": True,
+                                          "claims": ["G"]}, "unasked": ["G(F(b))"]}
+    assert list(gap.to_json()) == ["left_out", "unasked"]
+    assert Gaps.from_json(gap.to_json()) == gap
+    assert not Gaps.from_json({"stl": None})  # an answer that did not parse has no fields
+    assert gap.count(timed=False) == len(gap) == 4
