@@ -170,7 +170,7 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     start = time.perf_counter()
     request = Request.of(nl, aps)
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)
-    # Without intervals no answer can write a bound: only propositions can be mended.
+    # Without intervals no answer can write a bound: only the other gaps count.
     bounds = translator.config.intervals
     gap = _missing(request, greedy.stl, bounds)
     helpless = not translator.can_score and not getattr(translator.backend, "can_sample", True)
@@ -303,11 +303,8 @@ def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[S
 
 def _missing(request: Request, stl: str | None, bounds: bool = True) -> float:
     """How much of the request an answer leaves out (an unparsed one: everything);
-    without ``bounds``, only the propositions count."""
-    if stl is None:
-        return float("inf")
-    gap = gaps(request, parse(stl))
-    return len(gap) if bounds else len(gap.aps)
+    without ``bounds``, every gap but the bounds left out counts."""
+    return float("inf") if stl is None else gaps(request, parse(stl)).count(timed=bounds)
 
 
 def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, ...]]:
