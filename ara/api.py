@@ -2,16 +2,17 @@
 
     >>> import ara
     >>> answer = ara.translate("Never enter the server room.", ["enter_server_room"])
-    >>> answer["stl"]
+    >>> answer.stl
     'G(!enter_server_room)'
     >>> ara.explain("G(battery_low -> F[0,30](at_charger))")
     'whenever battery_low, at_charger within 30 steps'
     >>> ara.equivalent("G(!(a | b))", "G(!a) & G(!b)")
     True
 
-:func:`translate` returns what ``ara translate --json`` prints (the formula, its
+:func:`translate` returns an :class:`~ara.eval.answering.Answer` (the formula, its
 confidence, the other readings where the model doubts, what it leaves out of the
-request) and keeps the model loaded between calls. For finer control use the parts
+request; ``answer.to_json()`` is what ``ara translate --json`` prints) and keeps the
+model loaded between calls. For finer control use the parts
 it is made of: :class:`ara.eval.translator.Translator`,
 :func:`ara.eval.answering.answer`, :mod:`ara.grammars`.
 """
@@ -20,14 +21,18 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 from ara.grammars import parse
+
+if TYPE_CHECKING:  # the model's modules load on first use
+    from ara.eval.answering import Answer
 
 
 def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
               shots: int | None = None, seed: int = 0, intervals: bool = True,
               max_bound: int = 1000, any_bound: bool = False, server: str = "openai",
-              examples_by: str = "random", examples: str | None = None, **how) -> dict:
+              examples_by: str = "random", examples: str | None = None, **how) -> Answer:
     """Translate one instruction into STL over ``aps``, as ``ara translate`` does.
 
     Args:
@@ -39,12 +44,13 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
         examples_by, examples: How the ``shots`` worked examples are chosen (``random``
             or ``similar`` to ``nl``) and from which file of pairs (``None``: the
             training mixture), as ``--examples-by`` and ``--examples``.
-        **how: Fields of :class:`~ara.eval.answering.AnswerConfig` (``repair``,
+        **how: ``ara translate``'s other options, as :meth:`AnswerConfig.of
+            <ara.eval.answering.AnswerConfig.of>` names them (``repair``, ``repair_by``,
             ``samples``, ``doubt``, ``alternatives``, ...).
 
     Returns:
-        The ``--json`` object: ``stl`` (``None`` if the model wrote no formula),
-        ``confidence``, ``alternatives``, ``left_out``, ``raw``, ``ms``, ...
+        The answer: ``stl`` (``None`` if the model wrote no formula), ``confidence``,
+        ``alternatives``, ``gaps``, ``result`` (the raw text, timings), ...
 
     Raises:
         ara.errors.AraError: On a request ``ara translate`` refuses (an empty
@@ -59,7 +65,7 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
                               bounds_from_request=not any_bound)
     check_request(nl, aps, config)
     # Options and worked examples first: a mistake there is refused before the model loads.
-    how = AnswerConfig(seed=seed, **how)
+    how = AnswerConfig.of(seed=seed, **how)
     shown = worked_examples(model, shots, aps, seed, nl, examples_by, examples)
     return answer(translator(model, config, server), nl, aps, shown, how)
 

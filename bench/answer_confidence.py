@@ -46,7 +46,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ara.eval.confidence import DOUBT, answer_probability
-from ara.eval.consistency import DEFAULT_REPAIR, readings, translate_consistent, translate_repaired
+from ara.eval.consistency import readings, translate_consistent, translate_repaired
 from ara.eval.harness import judge
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator
@@ -117,8 +117,7 @@ def score_folder(translator: Translator, folder: Path, timeout_s: float,
             record["resampled"] = {"stl": vote.result.stl, "right": bool(
                 judge(r["reference"], vote.result.stl, timeout_s)["equivalent"])}
         if others and record["probability"] < DOUBT:
-            vote = translate_repaired(translator, r["nl"], r["aps"], samples=DEFAULT_REPAIR,
-                                      timeout_s=timeout_s)
+            vote = translate_repaired(translator, r["nl"], r["aps"], timeout_s=timeout_s)
             record["readings"] = [
                 {"stl": stl, "probability": math.exp(score),
                  "right": bool(judge(r["reference"], stl, timeout_s)["equivalent"])}

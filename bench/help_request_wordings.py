@@ -26,7 +26,7 @@ from ara.coordination.protocol import (
     template_help_spec,
 )
 from ara.coordination.world import GridWorld
-from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
+from ara.eval.consistency import translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator
 from ara.grammars import parse
@@ -51,8 +51,8 @@ def main() -> None:
     for wording, site in tqdm(jobs, desc="requests", unit="request"):
         drop = world.nearest_free_neighbour(site)
         text = request_text(site, CAPS, wording=wording)
-        vote = translate_repaired(translator, text, help_props(site, drop), request_shots(),
-                                  samples=DEFAULT_REPAIR)  # as a helper reads it
+        vote = translate_repaired(translator, text, help_props(site, drop),
+                                  request_shots())  # repaired as a helper reads it
         result = vote.result
         try:
             same = equivalent(parse(result.stl), template_help_spec(site, drop, ()),

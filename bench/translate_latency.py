@@ -31,7 +31,7 @@ import time
 
 from ara.data import load_or_prepare
 from ara.eval.answering import answer
-from ara.eval.consistency import REPAIR_BY, translate_repaired
+from ara.eval.consistency import REPAIR_BY, RepairConfig, translate_repaired
 from ara.eval.models import make_backend
 from ara.eval.translator import Translator, TranslatorConfig
 
@@ -51,7 +51,7 @@ def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_B
         runs, ms = [], []
         for r in records:
             start = time.perf_counter()
-            vote = translate_repaired(translator, r.nl, r.aps, samples=repair, by=by)
+            vote = translate_repaired(translator, r.nl, r.aps, repair=RepairConfig(repair, by))
             runs.append(vote.result)
             ms.append((time.perf_counter() - start) * 1e3)
     else:

@@ -125,9 +125,9 @@ def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
         from ara.eval.answering import answer, notes
 
         # Answered and checked as `ara translate` does, so the demo shows what a user gets
-        data = answer(translator, errand.nl, aps)
-        stl, source = data["stl"], f"translated by {translator.backend.model_id}"
-        warnings, probability = notes(data, errand.nl), data["confidence"]
+        answered = answer(translator, errand.nl, aps)
+        stl, source = answered.stl, f"translated by {answered.model}"
+        warnings, probability = notes(answered, errand.nl), answered.confidence
     echo(f"[STL, {source}] {stl}")
     for warning in warnings:
         echo(warning)

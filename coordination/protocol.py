@@ -289,14 +289,13 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     others = sorted(own_vocab.events)
     template = template_help_spec(site, drop, others)
     if translator is not None:
-        from ara.eval.consistency import DEFAULT_REPAIR, translate_repaired
+        from ara.eval.consistency import translate_repaired
 
         shots = request_shots() if shots is None else shots
         # Repaired as `ara translate` repairs, so a helper reads a request as a user's
         # own translation would: the greedy answer unless it leaves part out or the
         # model doubts it.
-        result = translate_repaired(translator, request.text, (pick, place), shots,
-                                    samples=DEFAULT_REPAIR).result
+        result = translate_repaired(translator, request.text, (pick, place), shots).result
         if not result.valid:
             return _decline(helper, f"could not translate the request ({result.error})")
         help_formula = parse(result.stl)

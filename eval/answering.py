@@ -1,9 +1,10 @@
 """One instruction in, one answer out, as ``ara translate`` gives it to a user.
 
-``ara translate`` and ``ara translate-file`` share this: the translation (greedy, voted
-or repaired), the model's confidence in it, the other readings it weighed when it
-doubts, and what the answer leaves out of the request. Each answer is a plain dict, the
-``--json`` object and one line of a ``translate-file`` output.
+``ara translate``, ``ara translate-file``, :func:`ara.translate`, the ablation harness and
+``ara demo`` share this: the translation (greedy, voted or repaired), the model's
+confidence in it, the other readings it weighed when it doubts, and what the answer
+leaves out of the request. Each answer is an :class:`Answer`; its :meth:`Answer.to_json`
+is the ``--json`` object and one line of a ``translate-file`` output.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import math
 import random
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -19,8 +20,8 @@ from ara.errors import ConfigError
 from ara.eval.checks import Gaps, gaps
 from ara.eval.confidence import DOUBT, doubt_warning, result_probability, winner_probability
 from ara.eval.consistency import (
-    DEFAULT_REPAIR,
     REPAIR_BY,
+    RepairConfig,
     Vote,
     readings,
     translate_consistent,
@@ -28,7 +29,7 @@ from ara.eval.consistency import (
 )
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.request import Request
-from ara.eval.translator import Translator
+from ara.eval.translator import TranslationResult, Translator
 from ara.grammars import parse
 
 #: Seconds Spot may take to tell whether two readings mean the same; an undecided pair
@@ -44,25 +45,16 @@ class AnswerConfig:
     Attributes:
         samples: Self-consistency: greedy + ``samples - 1`` sampled answers, the largest
             group by meaning wins; 1: no vote. 1 to 32.
-        repair: Extra answers to draw where the greedy one leaves out part of the
-            request or the model doubts it (:func:`translate_repaired`); 0: off.
-            ``None``: :data:`DEFAULT_REPAIR`, or 0 with ``samples`` or unconstrained.
-        repair_by: One of :data:`REPAIR_BY`.
-        doubt: Probability below which repair by samples+edits searches a complete
-            answer too, 0 to 1 (0: gaps only).
-        temperature: For the sampled answers, > 0.
-        seed: Sampled answer ``i`` is drawn with seed ``seed + i``.
+        repair: How extra answers are drawn, by repair and by the vote; repair draws
+            ``repair.samples`` (``None``: :data:`DEFAULT_REPAIR`, or 0 with ``samples``
+            or unconstrained).
         grammar_in_prompt: Show the grammar in the prompt.
         constrained: Decode under the grammar.
         alternatives: Other readings to report when the model doubts its answer, 0 to 8.
     """
 
     samples: int = 1
-    repair: int | None = None
-    repair_by: str = REPAIR_BY[0]
-    doubt: float = DOUBT
-    temperature: float = 0.7
-    seed: int = 0
+    repair: RepairConfig = RepairConfig()
     grammar_in_prompt: bool = False
     constrained: bool = True
     alternatives: int = 2
@@ -70,93 +62,128 @@ class AnswerConfig:
     def __post_init__(self) -> None:
         if not 1 <= self.samples <= 32:
             raise ConfigError(f"samples must be 1 to 32, got {self.samples}")
-        if self.repair is not None and not 0 <= self.repair <= 32:
-            raise ConfigError(f"repair must be 0 to 32, got {self.repair}")
         if self.samples > 1 and not self.constrained:
             raise ConfigError("--samples decodes under the grammar (every sample valid); "
                               "drop --no-constraint")
-        if self.samples > 1 and self.repair:
+        if self.samples > 1 and self.repair.samples:
             raise ConfigError("--samples and --repair are two ways to spend extra answers; "
                               "pass one")
-        if self.repair and not self.constrained:
+        if self.repair.samples and not self.constrained:
             raise ConfigError("--repair decodes under the grammar; drop --no-constraint")
-        if self.repair_by not in REPAIR_BY:
-            raise ConfigError(f"--repair-by {self.repair_by!r}? choose one of "
-                              f"{', '.join(REPAIR_BY)}")
-        if not 0 <= self.doubt <= 1:
-            raise ConfigError(f"doubt is a probability, 0 to 1; got {self.doubt}")
-        if self.temperature <= 0:
-            raise ConfigError(f"temperature must be > 0, got {self.temperature}")
         if not 0 <= self.alternatives <= 8:
             raise ConfigError(f"alternatives must be 0 to 8, got {self.alternatives}")
+
+    @classmethod
+    def of(cls, samples: int = 1, repair: int | None = None, repair_by: str = REPAIR_BY[0],
+           doubt: float = DOUBT, temperature: float = 0.7, seed: int = 0,
+           **rest) -> AnswerConfig:
+        """The config of ``ara translate``'s options, named as the command names them."""
+        return cls(samples, RepairConfig(repair, repair_by, doubt, temperature, seed), **rest)
 
     @property
     def repairs(self) -> int:
         """The number of answers repair draws, the default resolved."""
-        if self.repair is not None:
-            return self.repair
-        return 0 if self.samples > 1 or not self.constrained else DEFAULT_REPAIR
+        if self.repair.samples is None and (self.samples > 1 or not self.constrained):
+            return 0
+        return self.repair.draws
+
+
+@dataclass(frozen=True)
+class Answer:
+    """One answer to a request, and what a user should know of it.
+
+    Attributes:
+        result: The winning translation (a mend's is the greedy one's with the formula
+            replaced).
+        model: The backend's model id.
+        vote: Every answer weighed, where more than one could be (a vote or repair).
+        confidence: The model's probability of the answer, to 3 significant digits;
+            ``None`` where the backend cannot score, or nobody asked.
+        alternatives: Other readings, each formula with its probability, listed only
+            when the confidence is below :data:`DOUBT`.
+        gaps: What the answer leaves out of the request or nests unasked
+            (:class:`~ara.eval.checks.Gaps`); ``None`` where it does not parse, or
+            nobody asked.
+    """
+
+    result: TranslationResult
+    model: str = ""
+    vote: Vote | None = None
+    confidence: float | None = None
+    alternatives: tuple[tuple[str, float], ...] = ()
+    gaps: Gaps | None = None
+
+    @property
+    def stl(self) -> str | None:
+        """The formula in canonical text, ``None`` if the model wrote none."""
+        return self.result.stl
+
+    @property
+    def ms(self) -> float:
+        """Wall time of every generation and check, in milliseconds."""
+        return self.vote.ms if self.vote else self.result.ms
+
+    @property
+    def attempts(self) -> int:
+        """Generations weighed (more than one: voted or repaired)."""
+        return len(self.vote.results) if self.vote else 1
+
+    def to_json(self) -> dict:
+        """The ``--json`` object of ``ara translate``: ``stl``, ``valid``, ``raw``, ``ms``
+        (all generations), ``error``, ``model``, ``constrained``, ``shots``, ``grammar``;
+        ``samples`` (every answer, their groups and scores) where more than one was
+        weighed; ``confidence``; ``alternatives`` (each ``stl`` and ``probability``);
+        ``left_out`` and ``unasked`` (:meth:`~ara.eval.checks.Gaps.to_json`) where the
+        answer parses."""
+        r, vote = self.result, self.vote
+        data = {"stl": r.stl, "valid": r.valid, "raw": r.raw, "ms": round(self.ms, 1),
+                "error": r.error, "model": self.model, "constrained": r.constrained,
+                "shots": r.shots, "grammar": r.grammar}
+        if vote is not None:
+            data["samples"] = {"answers": list(vote.answers),
+                               "groups": [list(g) for g in vote.groups],
+                               "agreement": round(vote.agreement, 3)}
+            if vote.scores:
+                data["samples"]["scores"] = [None if x is None else round(x, 3)
+                                             for x in vote.scores]
+        data["confidence"] = self.confidence
+        data["alternatives"] = [{"stl": stl, "probability": p} for stl, p in self.alternatives]
+        return data | (self.gaps.to_json() if self.gaps is not None else {})
 
 
 def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot] = (),
-           config: AnswerConfig | None = None) -> dict:
-    """Translate ``nl`` over ``aps`` as ``config`` says, with what a user should know.
-
-    Returns:
-        The ``--json`` object of ``ara translate``: ``stl``, ``valid``, ``raw``, ``ms``
-        (all generations), ``error``, ``model``, ``constrained``, ``shots``,
-        ``grammar``; ``samples`` (every answer, their groups and scores) where more
-        than one was weighed; ``confidence`` (the model's probability of the answer,
-        ``None`` where the backend cannot score); ``alternatives`` (other readings, each
-        ``stl`` and ``probability``, listed only when the confidence is below
-        :data:`DOUBT`); ``left_out`` (listed propositions and stated bounds the answer
-        never uses; ``order``: whether it orders nothing where the sentence asks
-        for one step after another; ``claims``: ``G``, ``F``, ``G(F)`` the sentence asks
-        for in words and the answer never writes, :func:`~ara.eval.checks.unclaimed`)
-        and ``unasked`` (subformulas nesting temporal
-        operators or ordering steps as the sentence never asks,
-        :func:`~ara.eval.checks.unasked`), where the answer parses.
-    """
+           config: AnswerConfig | None = None) -> Answer:
+    """Translate ``nl`` over ``aps`` as ``config`` says, with what a user should know: the
+    model's confidence, the other readings where it doubts the answer
+    (:data:`DOUBT`), and the answer's gaps (:func:`~ara.eval.checks.gaps`)."""
     config = config or AnswerConfig()
     vote: Vote | None = None
+    repair = config.repair
     if config.samples > 1:
         vote = translate_consistent(translator, nl, aps, shots, config.samples,
-                                    config.temperature, config.seed,
+                                    repair.temperature, repair.seed,
                                     grammar_in_prompt=config.grammar_in_prompt)
         result = vote.result
     elif config.repairs:
-        vote = translate_repaired(translator, nl, aps, shots, config.repairs,
-                                  config.temperature, config.seed,
-                                  grammar_in_prompt=config.grammar_in_prompt,
-                                  by=config.repair_by, doubt=config.doubt)
+        vote = translate_repaired(translator, nl, aps, shots,
+                                  replace(repair, samples=config.repairs),
+                                  grammar_in_prompt=config.grammar_in_prompt)
         result = vote.result
     else:
         result = translator.translate(nl, aps, shots, config.grammar_in_prompt,
                                       constrained=config.constrained)
-    data = {"stl": result.stl, "valid": result.valid, "raw": result.raw,
-            "ms": round(vote.ms if vote else result.ms, 1), "error": result.error,
-            "model": translator.backend.model_id, "constrained": result.constrained,
-            "shots": len(shots), "grammar": result.grammar}
-    if vote is not None:
-        data["samples"] = {"answers": list(vote.answers), "groups": [list(g) for g in vote.groups],
-                           "agreement": round(vote.agreement, 3)}
-        if vote.scores:
-            data["samples"]["scores"] = [None if x is None else round(x, 3)
-                                         for x in vote.scores]
     probability = (winner_probability(translator, vote, shots, config.grammar_in_prompt)
                    if vote else result_probability(translator, result, shots,
                                                    config.grammar_in_prompt))
-    data["confidence"] = None if probability is None else _significant(probability)
-    others: list[tuple[str, float]] = []
-    if doubted(data) and vote is not None:
+    confidence = None if probability is None else _significant(probability)
+    others: tuple[tuple[str, float], ...] = ()
+    if doubted(confidence) and vote is not None:
         # The winner is scored whenever anything is, so the first reading is its.
-        others = [(stl, math.exp(score))
-                  for stl, score in readings(vote, SAME_READING_TIMEOUT_S,
-                                             limit=1 + config.alternatives)[1:]]
-    data["alternatives"] = [{"stl": stl, "probability": _significant(p)} for stl, p in others]
-    if result.stl is not None:
-        data |= gaps(Request.of(nl, aps), parse(result.stl)).to_json()
-    return data
+        others = tuple((stl, _significant(math.exp(score)))
+                       for stl, score in readings(vote, SAME_READING_TIMEOUT_S,
+                                                  limit=1 + config.alternatives)[1:])
+    found = None if result.stl is None else gaps(Request.of(nl, aps), parse(result.stl))
+    return Answer(result, translator.backend.model_id, vote, confidence, others, found)
 
 
 def _significant(p: float) -> float:
@@ -212,23 +239,20 @@ def _pool_file(path: str) -> tuple:
     return tuple(read_pairs(Path(path), TranslatorConfig()))
 
 
-def notes(data: dict, nl: str = "") -> list[str]:
-    """What to tell a user about an answer (:func:`answer`'s dict), as ``ara translate``
-    prints it on stderr: what it leaves out of the request (quoting the words of ``nl``
-    that ask for it), and, if the model doubts it, the answer read back with the other
-    readings it weighed."""
-    if data["stl"] is None:
+def notes(answer: Answer, nl: str = "") -> list[str]:
+    """What to tell a user about an answer, as ``ara translate`` prints it on stderr: what
+    it leaves out of the request (quoting the words of ``nl`` that ask for it), and, if
+    the model doubts it, the answer read back with the other readings it weighed."""
+    if answer.stl is None:
         return []
     said = []
-    gap = Gaps.from_json(data)
-    if gap:
-        said.append(gap.warning(Request.of(nl, ())))  # data lists no aps: read nl whole
-    if doubted(data):
-        others = [(a["stl"], a["probability"]) for a in data["alternatives"]]
-        said.append(doubt_warning(data["stl"], data["confidence"], others))
+    if answer.gaps:
+        said.append(answer.gaps.warning(Request.of(nl, ())))  # no aps here: read nl whole
+    if doubted(answer.confidence):
+        said.append(doubt_warning(answer.stl, answer.confidence, list(answer.alternatives)))
     return said
 
 
-def doubted(data: dict) -> bool:
-    """Whether the model gives an answer (:func:`answer`'s dict) less than :data:`DOUBT`."""
-    return data["confidence"] is not None and data["confidence"] < DOUBT
+def doubted(confidence: float | None) -> bool:
+    """Whether the model gives an answer (its ``confidence``) less than :data:`DOUBT`."""
+    return confidence is not None and confidence < DOUBT

@@ -10,7 +10,8 @@ The input is JSON Lines, one request per line::
 checked before the first is translated, so a typo on line 90 costs nothing. Each
 answer is written and flushed as soon as it is made (the line of ``ara translate
 --json``, with the request), so an interrupted run keeps what it did and ``resume``
-goes on from there.
+goes on from there; the settings it answers with are kept beside the answers
+(:func:`settings_path`), so that a resumed run answers as the run it goes on with.
 """
 
 from __future__ import annotations
@@ -149,6 +150,41 @@ def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int
     return len(rows)
 
 
+def settings_path(out: Path) -> Path:
+    """Where the settings of the run that writes ``out`` are kept: ``answers.jsonl`` ->
+    ``answers.settings.json``, so that ``out`` stays one answer per line."""
+    return out.with_suffix(".settings.json")
+
+
+def same_settings(out: Path, settings: dict) -> None:
+    """Keep ``settings`` (names to JSON values, nested) beside a new ``out``; for one a run
+    already wrote to, check they are those it was made with.
+
+    Raises:
+        ConfigError: If ``out`` was made with other settings, naming the first that differs.
+    """
+    path = settings_path(out)
+    now = _flat(json.loads(json.dumps(settings)))  # tuples compare as the lists saved
+    if not out.exists() or not out.stat().st_size:
+        path.write_text(json.dumps(settings, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    elif path.exists():  # outputs from before settings were kept resume as they did
+        before = _flat(json.loads(path.read_text(encoding="utf-8")))
+        for name in sorted(before.keys() | now.keys()):
+            if before.get(name) != now.get(name):
+                raise ConfigError(
+                    f"{out} was made with {name} = {json.dumps(before.get(name))}, this run has "
+                    f"{json.dumps(now.get(name))} ({path}): pass the options it was made with "
+                    "to resume it, or choose another --out")
+
+
+def _flat(value: object, prefix: str = "") -> dict:
+    """``{"a": {"b": 1}}`` -> ``{"a.b": 1}``."""
+    if not isinstance(value, dict):
+        return {prefix: value}
+    return {name: leaf for key, sub in value.items()
+            for name, leaf in _flat(sub, f"{prefix}.{key}" if prefix else key).items()}
+
+
 def translate_requests(translator: Translator, requests: Iterable[FileRequest], out: Path,
                        shots_for: Callable[[str, Sequence[str]], Sequence[Shot]],
                        config: AnswerConfig | None = None,
@@ -156,7 +192,8 @@ def translate_requests(translator: Translator, requests: Iterable[FileRequest], 
     """Answer each request, append its line to ``out`` (flushed at once), and yield it.
 
     ``shots_for(nl, aps)`` gives the worked examples for a request. A line is
-    the request (``line``, ``id`` if any, ``nl``, ``aps``) and :func:`answer`'s dict;
+    the request (``line``, ``id`` if any, ``nl``, ``aps``) and its answer's
+    :meth:`~ara.eval.answering.Answer.to_json`;
     with a reference, also ``reference`` and Spot's ``equivalent`` (``None``:
     undecided in ``spot_timeout_s``).
     """
@@ -168,10 +205,11 @@ def translate_requests(translator: Translator, requests: Iterable[FileRequest], 
                 row["id"] = request.id
             row |= {"nl": request.nl, "aps": list(request.aps)}
             shown = shots_for(request.nl, request.aps)
-            row |= answer(translator, request.nl, request.aps, shown, config)
+            answered = answer(translator, request.nl, request.aps, shown, config)
+            row |= answered.to_json()
             if request.reference is not None:
                 row["reference"] = request.reference
-                row["equivalent"] = judge(request.reference, row["stl"],
+                row["equivalent"] = judge(request.reference, answered.stl,
                                           spot_timeout_s)["equivalent"]
             sink.write(json.dumps(row) + "\n")
             sink.flush()
@@ -183,13 +221,13 @@ def summarize(rows: Sequence[dict]) -> dict:
     operators unasked; and where lines
     have references, how many the answers match (also among the undoubted)."""
     summary = {"answers": len(rows), "valid": sum(r["valid"] for r in rows),
-               "doubted": sum(doubted(r) for r in rows),
+               "doubted": sum(doubted(r["confidence"]) for r in rows),
                "left_out": sum(any(k != "unasked" for k in Gaps.from_json(r).kinds())
                                for r in rows),
                "unasked": sum(bool(Gaps.from_json(r).unasked) for r in rows)}
     judged = [r for r in rows if "reference" in r]
     if judged:
-        sure = [r for r in judged if not doubted(r)]
+        sure = [r for r in judged if not doubted(r["confidence"])]
         summary |= {"with_reference": len(judged),
                     "equivalent": sum(r["equivalent"] is True for r in judged),
                     "undecided": sum(r["equivalent"] is None for r in judged),

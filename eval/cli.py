@@ -11,8 +11,7 @@ import typer
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
 from ara.eval.confidence import DOUBT
-from ara.eval.consistency import DEFAULT_REPAIR as REPAIR
-from ara.eval.consistency import REPAIR_BY
+from ara.eval.consistency import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -52,29 +51,12 @@ ANY_BOUND = typer.Option(
     False, "--any-bound",
     help="Let intervals use any number up to --max-bound; by default they use only 0 "
          "and the numbers the sentence writes (digits, or words up to 'hundred').")
-TEMPERATURE = typer.Option(0.7, "--temperature", min=0.01,
-                           help="Sampling temperature for --samples and --repair.")
-REPAIR_OPTION = typer.Option(
-    None, "--repair", min=0, max=32,
-    help=f"When the greedy answer has a gap (it leaves out a proposition in --aps, a "
-         f"number the sentence states as time, an order it asks for with 'then', or an "
-         f"'always', 'at some point' or 'again and again' it asks for in words; or it "
-         f"nests F and G or orders steps where the sentence has no words for that), look "
-         f"for an answer with fewer gaps (a greedy answer with none costs nothing "
-         f"more), drawing K answers under the grammar (see --repair-by). Default "
-         f"{REPAIR}, or 0 with --samples; 0: off.")
-REPAIR_BY_OPTION = typer.Option(
-    REPAIR_BY[0], "--repair-by",
-    help="samples+edits: the K answers drawn and the formulas one edit from the "
-         "greedy answer that close a gap; the one the model scores "
-         "highest of those with the fewest gaps wins. edits: the edits alone. "
-         "samples: the majority of the K drawn with the fewest gaps (also what the "
-         "others do with an HTTP --model, which cannot score).")
-DOUBT_OPTION = typer.Option(
-    DOUBT, "--doubt", min=0.0, max=1.0,
-    help="With repair by samples+edits: also draw the K answers when the greedy "
-         "answer leaves nothing out but the model gives it a probability below this, "
-         "and keep the best-scored complete one. 0: repair answers with a gap only.")
+# Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
+TEMPERATURE = typer.Option(0.7, "--temperature", help=REPAIR_HELP["temperature"])
+REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
+                             f"{DEFAULT_REPAIR}, or 0 with --samples; 0: off.")
+REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])
+DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
     help="When the model doubts its answer, list up to this many other readings it "
@@ -126,16 +108,18 @@ def translate_cmd(
     from ara.eval.answering import notes
 
     with user_errors():  # the same path as ara.translate from Python
-        data = translate(nl, split_list(aps), model, shots=shots, seed=seed,
+        answer = translate(nl, split_list(aps), model, shots=shots, seed=seed,
                          examples_by=examples_by, examples=examples,
                          intervals=intervals, max_bound=max_bound, any_bound=any_bound,
                          server=server, samples=samples, repair=repair, repair_by=repair_by,
                          doubt=doubt, temperature=temperature,
                          grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
                          alternatives=alternatives)
-    for note in [] if as_json else notes(data, nl):  # JSON users read the fields
+    for note in [] if as_json else notes(answer, nl):  # JSON users read the fields
         typer.echo(note, err=True)
-    emit(data, as_json, lambda d: d["stl"] if d["valid"] else f"invalid: {d['error']}\n{d['raw']}")
+    r = answer.result
+    emit(answer.to_json(), as_json,
+         lambda _: r.stl if r.valid else f"invalid: {r.error}\n{r.raw}")
 
 
 def translate_file_cmd(
@@ -145,7 +129,9 @@ def translate_file_cmd(
     out: Path = typer.Option(..., "--out", help="JSON Lines: each request with its answer "
                              "(the object of ara translate --json), written as it is made."),
     resume: bool = typer.Option(False, "--resume",
-                                help="Go on with an --out an interrupted run left."),
+                                help="Go on with an --out an interrupted run left, made "
+                                     "with the same options (kept beside it, in "
+                                     "OUT.settings.json)."),
     model: str = MODEL,
     shots: int | None = SHOTS,
     examples_by: str = EXAMPLES_BY,
@@ -175,6 +161,8 @@ def translate_file_cmd(
     (confidence below 0.5), leave part of the request out, and, for lines
     with a reference, how many are Spot-equivalent to it.
     """
+    from dataclasses import asdict
+
     from tqdm import tqdm
 
     from ara.data.normalize import form_of
@@ -182,6 +170,7 @@ def translate_file_cmd(
     from ara.eval.batch import (
         done_lines,
         read_requests,
+        same_settings,
         summarize,
         summary_table,
         translate_requests,
@@ -193,14 +182,18 @@ def translate_file_cmd(
         config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
                                   bounds_from_request=not any_bound)
         todo = read_requests(requests, config)
-        how = AnswerConfig(repair=repair, repair_by=repair_by, doubt=doubt,
-                           temperature=temperature, seed=seed, alternatives=alternatives)
+        how = AnswerConfig.of(repair=repair, repair_by=repair_by, doubt=doubt,
+                              temperature=temperature, seed=seed, alternatives=alternatives)
         if out.is_dir():
             raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
         if out.exists() and out.stat().st_size and not resume:
             raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
                               "another --out")
         translator = Translator(shared_backend(model, server=server), config)
+        same_settings(out, {"model": translator.backend.model_id, "answer": asdict(how),
+                            "translator": asdict(config), "shots": shots,
+                            "examples_by": examples_by,
+                            "examples": None if examples is None else str(examples)})
         done = done_lines(out, todo, translator.backend.model_id)
         drawn: dict[str, list] = {}
 
@@ -276,23 +269,14 @@ def ablation_cmd(
         1, "--concurrency",
         help="Requests in flight at once, for an http(s):// --model (the server batches "
              "them); samples are still written in order, and --resume works as usual."),
-    repair: int = typer.Option(
-        0, "--repair", min=0, max=32,
-        help="Constrained variants: when the greedy answer has a gap (as `ara translate "
-             "--repair` says), look for an answer with fewer gaps, drawing K more (see "
-             "--repair-by). 0 (the paper's variants): greedy."),
-    repair_by: str = typer.Option(
-        REPAIR_BY[0], "--repair-by",
-        help="samples+edits (the model's best-scored of the K drawn and the greedy "
-             "answer's one-edit mends), edits (the mends alone) or samples (the majority "
-             "of the K drawn)."),
-    doubt: float = typer.Option(
-        DOUBT, "--doubt", min=0.0, max=1.0,
-        help="With --repair by samples+edits: also draw for a complete greedy answer the "
-             "model gives a probability below this (0: answers with a gap only)."),
+    repair: int = typer.Option(0, "--repair", help="Constrained variants: "
+                               + REPAIR_HELP["samples"] + " 0 (the paper's variants): greedy."),
+    repair_by: str = REPAIR_BY_OPTION,
+    doubt: float = DOUBT_OPTION,
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import load_data, run_ablation
+    from ara.eval.consistency import RepairConfig
     from ara.eval.harness import FILE_SPLIT, AblationConfig, plan
     from ara.eval.models import make_backend
     from ara.eval.report import tables_markdown
@@ -311,8 +295,8 @@ def ablation_cmd(
             examples=None if examples is None else str(examples),
             variants=split_list(variants),
             shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
-            seed=seed, model=model, spot_timeout_s=spot_timeout, repair=repair,
-            repair_by=repair_by, repair_doubt=doubt, examples_by=examples_by,
+            seed=seed, model=model, spot_timeout_s=spot_timeout,
+            repair=RepairConfig(repair, repair_by, doubt), examples_by=examples_by,
         )
         loaded = load_data(config)
         plan(config, loaded)  # a bad file or plan is named before the model loads

@@ -43,6 +43,63 @@ DEFAULT_REPAIR = 8
 #: How repair looks for a better answer (see :func:`translate_repaired`).
 REPAIR_BY = ("samples+edits", "edits", "samples")
 
+#: The help of each repair option, shared by ``ara translate``, ``translate-file`` and
+#: ``ara eval ablation``; each command adds its own default for ``samples``.
+REPAIR_HELP = {
+    "samples": "When the greedy answer has a gap (it leaves out a proposition in --aps, a "
+               "number the sentence states as time, an order it asks for with 'then', or "
+               "an 'always', 'at some point' or 'again and again' it asks for in words; or "
+               "it nests F and G or orders steps where the sentence has no words for "
+               "that), look for an answer with fewer gaps (a greedy answer with none costs "
+               "nothing more), drawing K answers under the grammar (see --repair-by).",
+    "by": "samples+edits: the K answers drawn and the formulas one edit from the greedy "
+          "answer that close a gap; the one the model scores highest of those with the "
+          "fewest gaps wins. edits: the edits alone. samples: the majority of the K drawn "
+          "with the fewest gaps (also what the others do with an HTTP --model, which "
+          "cannot score).",
+    "doubt": "With repair by samples+edits: also draw the K answers when the greedy answer "
+             "leaves nothing out but the model gives it a probability below this, and keep "
+             "the best-scored complete one. 0: repair answers with a gap only.",
+    "temperature": "Sampling temperature for --samples and --repair.",
+}
+
+
+@dataclass(frozen=True)
+class RepairConfig:
+    """How :func:`translate_repaired` looks for a better answer than the greedy one.
+
+    Attributes:
+        samples: Extra answers to draw when the greedy one has a gap or is doubted, 0 to
+            32 (0: greedy only); ``None``: :data:`DEFAULT_REPAIR`, where repair is on by
+            default (:class:`~ara.eval.answering.AnswerConfig` turns it off for a vote).
+        by: One of :data:`REPAIR_BY`.
+        doubt: By ``samples+edits``: also draw for a complete greedy answer the model
+            gives a probability below this, 0 to 1 (0: gaps only).
+        temperature: For the drawn answers, > 0.
+        seed: Drawn answer ``i`` (from 1) has seed ``seed + i``.
+    """
+
+    samples: int | None = None
+    by: str = REPAIR_BY[0]
+    doubt: float = DOUBT
+    temperature: float = 0.7
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.samples is not None and not 0 <= self.samples <= 32:
+            raise ConfigError(f"repair draws 0 to 32 answers (--repair), got {self.samples}")
+        if self.by not in REPAIR_BY:
+            raise ConfigError(f"--repair-by {self.by!r}? choose one of {', '.join(REPAIR_BY)}")
+        if not 0 <= self.doubt <= 1:
+            raise ConfigError(f"doubt is a probability, 0 to 1 (0: gaps only); got {self.doubt}")
+        if self.temperature <= 0:
+            raise ConfigError(f"temperature must be > 0, got {self.temperature}")
+
+    @property
+    def draws(self) -> int:
+        """The number of answers repair may draw, the default resolved."""
+        return DEFAULT_REPAIR if self.samples is None else self.samples
+
 
 @dataclass(frozen=True)
 class Vote:
@@ -126,26 +183,23 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
 
 
 def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
-                       shots: Sequence[Shot] = (), samples: int = 8,
-                       temperature: float = 0.7, seed: int = 0, timeout_s: float = 10.0,
-                       grammar_in_prompt: bool = False, by: str = "samples+edits",
-                       doubt: float = DOUBT) -> Vote:
+                       shots: Sequence[Shot] = (), repair: RepairConfig = RepairConfig(),
+                       timeout_s: float = 10.0, grammar_in_prompt: bool = False) -> Vote:
     """Translate ``nl`` greedily; if the answer leaves out part of the request, look for
     one that leaves out less, and if the model doubts it, for one it scores higher.
 
     Args:
-        translator, nl, aps, shots, temperature, timeout_s, grammar_in_prompt: As
+        translator, nl, aps, shots, timeout_s, grammar_in_prompt: As
             :func:`translate_consistent`.
-        samples: Extra answers to draw when the greedy one has a gap, >= 0 (0: greedy).
-        seed: Extra answer ``i`` (from 1) is drawn with seed ``seed + i``.
-        by: ``samples+edits``: draw ``samples`` answers under the grammar, add the
+        repair: How many answers to draw (``samples``), and how (``by``):
+            ``samples+edits``: draw ``samples`` answers under the grammar, add the
             formulas one edit from the greedy answer that write what it left out
             (:func:`literal_mends`), and keep the model's best-scored answer among
             those that leave out least. ``edits``: the same without the samples
             (drawn only if no edit fits the request's grammar). ``samples``: keep the
             majority meaning among the samples that leave out least, which is also
             what the other two do where the backend cannot score.
-        doubt: By ``samples+edits`` on a backend that scores: when the greedy answer
+            ``doubt``: by ``samples+edits`` on a backend that scores, when the greedy answer
             leaves nothing out but the model gives it a probability below ``doubt``
             (:mod:`ara.eval.confidence`), draw ``samples`` answers and keep the
             best-scored of those and the greedy one that leave nothing out (an answer
@@ -161,12 +215,8 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
         the greedy one's with the formula replaced (timings and token counts are the
         greedy call's).
     """
-    if samples < 0:
-        raise ConfigError(f"samples must be >= 0, got {samples}")
-    if by not in REPAIR_BY:
-        raise ConfigError(f"repair by {by!r}? choose one of {', '.join(REPAIR_BY)}")
-    if not 0 <= doubt <= 1:
-        raise ConfigError(f"doubt is a probability, 0 to 1 (0: gaps only); got {doubt}")
+    samples, by, doubt = repair.draws, repair.by, repair.doubt
+    temperature, seed = repair.temperature, repair.seed
     start = time.perf_counter()
     request = Request.of(nl, aps)
     greedy = translator.translate(nl, aps, shots, grammar_in_prompt)

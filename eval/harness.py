@@ -22,11 +22,11 @@ from ara import __version__
 from ara.data import Record
 from ara.data.store import FORMS, SPLITS
 from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
-from ara.eval.confidence import DOUBT
-from ara.eval.consistency import REPAIR_BY, translate_repaired
+from ara.eval.answering import Answer
+from ara.eval.consistency import RepairConfig, translate_repaired
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.similar import EXAMPLES_BY, index_for
-from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
+from ara.eval.translator import Translator, TranslatorConfig
 from ara.grammars import GRAMMAR_VERSION, parse
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
 from ara.provenance import git_commit
@@ -104,18 +104,11 @@ class AblationConfig:
         model: What ``--model`` named (recorded; the backend reports its hash).
         spot_timeout_s: Time limit per Spot check; past it the pair counts as undecided.
         translator: Grammar and budget settings.
-        repair: With C: when the greedy answer leaves out a listed proposition or a
-            stated bound, look for one that leaves out less
-            (:func:`~ara.eval.consistency.translate_repaired`): the number of answers to
-            draw where sampling is the way (seeded, T=0.7); 0 (the paper's variants):
-            greedy only.
-        repair_by: ``samples+edits`` (the model's best-scored of the answers drawn and
-            the greedy answer's one-edit mends), ``edits`` (the mends alone) or
-            ``samples`` (the majority of those drawn; also the others' way where the
-            backend cannot score).
-        repair_doubt: By ``samples+edits``: also draw for a complete greedy answer the
-            model gives a probability below this, 0 to 1 (0: gaps only; runs repaired
-            before it existed read as 0).
+        repair: With C: when the greedy answer has a gap, look for one with fewer
+            (:func:`~ara.eval.consistency.translate_repaired`); ``samples`` 0 (the
+            paper's variants): greedy only. Saved as ``repair``, ``repair_by`` and
+            ``repair_doubt``, and only when on, as runs from before repair wrote none;
+            runs repaired before ``by`` or ``doubt`` existed read as ``samples`` and 0.
         examples_by: How the F variants' worked examples are chosen: ``random`` (drawn
             with the seed, the same for every test pair of a rerun) or ``similar`` (for
             each test pair, the pool's pairs most like it, :mod:`ara.eval.similar`,
@@ -133,9 +126,7 @@ class AblationConfig:
     model: str = "default"
     spot_timeout_s: float = 10.0
     translator: TranslatorConfig = field(default_factory=TranslatorConfig)
-    repair: int = 0
-    repair_by: str = REPAIR_BY[0]
-    repair_doubt: float = DOUBT
+    repair: RepairConfig = RepairConfig(samples=0)
     data: str | None = None
     examples: str | None = None
     examples_by: str = "random"
@@ -157,27 +148,25 @@ class AblationConfig:
             # express a single reference.
             object.__setattr__(self, "translator", replace(self.translator, intervals=True))
         if (not self.variants or any(not 0 <= k <= MAX_SHOTS for k in self.shots)
-                or self.reruns < 1 or self.limit < 1 or not 0 <= self.repair <= 32):
+                or self.reruns < 1 or self.limit < 1):
             raise ConfigError(
-                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1, "
-                "limit >= 1 and repair from 0 to 32; got "
-                f"variants={self.variants}, shots={self.shots}, reruns={self.reruns}, "
-                f"limit={self.limit}, repair={self.repair}"
+                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1 and "
+                f"limit >= 1; got variants={self.variants}, shots={self.shots}, "
+                f"reruns={self.reruns}, limit={self.limit}"
             )
-        if not 0 <= self.repair_doubt <= 1:
-            raise ConfigError(f"repair_doubt is a probability, 0 to 1; got {self.repair_doubt}")
+        if self.repair.samples is None:  # an ablation states its repair: none by default
+            raise ConfigError("repair.samples: name the answers to draw, 0 to 32 (0: off)")
         if self.examples_by not in EXAMPLES_BY:
             raise ConfigError(f"examples by {self.examples_by!r}? choose one of "
                               f"{', '.join(EXAMPLES_BY)}")
-        if self.repair_by not in REPAIR_BY:
-            raise ConfigError(f"repair by {self.repair_by!r}? choose one of "
-                              f"{', '.join(REPAIR_BY)}")
 
     def to_dict(self) -> dict:
         data = asdict(self)
         data["variants"], data["shots"] = list(self.variants), list(self.shots)
-        if not self.repair:  # as runs from before repair existed wrote it: they resume
-            del data["repair"], data["repair_by"], data["repair_doubt"]
+        del data["repair"]  # saved flat, as runs wrote it before it was one config
+        if self.repair.samples:  # and not at all without repair: older runs resume
+            data |= {"repair": self.repair.samples, "repair_by": self.repair.by,
+                     "repair_doubt": self.repair.doubt}
         if self.split != FILE_SPLIT:  # the same for runs from before files could be read
             del data["data"], data["examples"]
         if self.examples_by == "random":  # and before examples could be chosen by similarity
@@ -186,15 +175,15 @@ class AblationConfig:
 
     @classmethod
     def from_dict(cls, data: dict) -> AblationConfig:
-        known = {f.name for f in fields(cls)}
+        known = {f.name for f in fields(cls)} | {"repair_by", "repair_doubt"}
         unknown = set(data) - known
         if unknown:
             raise ConfigError(f"unknown keys {sorted(unknown)}; known: {sorted(known)}")
         data = dict(data)
-        if data.get("repair") and "repair_by" not in data:
-            data["repair_by"] = "samples"  # repaired before repair by edits existed
-        if data.get("repair") and "repair_doubt" not in data:
-            data["repair_doubt"] = 0.0  # repaired before doubted answers were
+        # Runs repaired before repair by edits, or of doubted answers, existed say so.
+        by, doubt = data.pop("repair_by", "samples"), data.pop("repair_doubt", 0.0)
+        repair = data.get("repair", 0)
+        data["repair"] = RepairConfig(repair, by, doubt) if repair else RepairConfig(samples=0)
         data["variants"], data["shots"] = tuple(data["variants"]), tuple(data["shots"])
         data["translator"] = TranslatorConfig(**data.get("translator", {}))
         return cls(**data)
@@ -301,30 +290,17 @@ def judge(reference: str, output: str | None, timeout_s: float) -> dict:
         return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
-@dataclass(frozen=True)
-class Answer:
-    """A job's translation, and how many generations it took (more than one: repaired)."""
-
-    result: TranslationResult
-    attempts: int = 1
-    ms: float | None = None
-
-    @property
-    def total_ms(self) -> float:
-        return self.result.ms if self.ms is None else self.ms
-
-
 def translate_job(translator: Translator, job: Job, config: AblationConfig) -> Answer:
     """The generation of one job (what may run concurrently against a server), repaired
-    as ``config`` says."""
+    as ``config`` says; neither scored nor checked for gaps, which a run does not report."""
     r = job.record
-    if config.repair and job.variant.constrained:
-        vote = translate_repaired(translator, r.nl, r.aps, job.examples, samples=config.repair,
-                                  grammar_in_prompt=job.variant.grammar_in_prompt,
-                                  by=config.repair_by, doubt=config.repair_doubt)
-        return Answer(vote.result, len(vote.results), vote.ms)
+    if config.repair.samples and job.variant.constrained:
+        vote = translate_repaired(translator, r.nl, r.aps, job.examples, config.repair,
+                                  grammar_in_prompt=job.variant.grammar_in_prompt)
+        return Answer(vote.result, translator.backend.model_id, vote)
     return Answer(translator.translate(r.nl, r.aps, job.examples,
-                                       job.variant.grammar_in_prompt, job.variant.constrained))
+                                       job.variant.grammar_in_prompt, job.variant.constrained),
+                  translator.backend.model_id)
 
 
 def sample_of(job: Job, answer: Answer, timeout_s: float) -> dict:
@@ -335,7 +311,7 @@ def sample_of(job: Job, answer: Answer, timeout_s: float) -> dict:
         "nl": r.nl, "aps": list(r.aps), "reference": r.stl, "raw": result.raw,
         "stl": result.stl, "valid": result.valid, "error": result.error,
         **judge(r.stl, result.stl, timeout_s),
-        "ms": round(answer.total_ms, 2), "attempts": answer.attempts,
+        "ms": round(answer.ms, 2), "attempts": answer.attempts,
         "prompt_tokens": result.prompt_tokens,
         "completion_tokens": result.completion_tokens, "cached_tokens": result.cached_tokens,
         "stop": result.stop, "masked_steps": result.masked_steps,

@@ -30,17 +30,18 @@ def test_a_request_the_command_refuses_is_refused_before_loading_a_model():
 
 @needs_llama
 def test_translate_gives_the_command_s_answer_and_keeps_the_model_loaded():
-    """Tests ara.translate with the shipped fine-tune: the `--json` object, the model
+    """Tests ara.translate with the shipped fine-tune: the typed answer, the model
     loaded once for two calls and shared by translators of other settings, and the
     module's own examples."""
     ara.translator.cache_clear()
     answer = ara.translate("Never enter the server room.", ["enter_server_room"])
-    assert answer["stl"] == "G(!enter_server_room)" and answer["valid"]
-    assert answer["confidence"] > 0.9 and answer["alternatives"] == []
-    assert answer["left_out"] == {"aps": [], "numbers": [], "order": False, "claims": []}
-    assert answer["unasked"] == []
+    assert answer.stl == "G(!enter_server_room)" and answer.result.valid
+    assert answer.confidence > 0.9 and answer.alternatives == ()
+    assert not answer.gaps
+    assert answer.to_json()["left_out"] == {"aps": [], "numbers": [], "order": False,
+                                            "claims": []}
     timed = ara.translate("within 20 steps reach ( prop_1 )", ["prop_1"], repair=0)
-    assert timed["stl"] == "F[0,20](prop_1)" and "samples" not in timed  # greedy
+    assert timed.stl == "F[0,20](prop_1)" and timed.vote is None  # greedy
     assert ara.translator.cache_info().misses == 1  # one load for both
     # other settings, and the command line's own path, share the model loaded
     from ara.eval.models import shared_backend

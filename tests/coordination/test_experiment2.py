@@ -185,7 +185,7 @@ def test_helpers_share_one_translation_of_a_request(llama_backend):
     it as any translator."""
     from ara.coordination.experiment2 import SharedTranslator
     from ara.eval.backends.base import Sampling
-    from ara.eval.consistency import translate_repaired
+    from ara.eval.consistency import RepairConfig, translate_repaired
     from ara.eval.translator import Translator
 
     shared = SharedTranslator(Translator(llama_backend))
@@ -196,7 +196,7 @@ def test_helpers_share_one_translation_of_a_request(llama_backend):
     assert shared.translate(nl, aps, sampling=Sampling(temperature=0.7, seed=1)) is drawn
     other = shared.translate("eventually ( prop_1 )", aps)
     assert other is not first and shared.translate(nl, aps) is not first  # forgotten
-    vote = translate_repaired(shared, nl, aps, samples=2)
+    vote = translate_repaired(shared, nl, aps, repair=RepairConfig(2))
     assert vote.results[0] is shared.translate(nl, aps)  # repair's greedy call, kept
     # the greedy answer alone, or with 2 samples and the greedy answer's mends
     assert len(vote.results) == 1 or len(vote.results) >= 3

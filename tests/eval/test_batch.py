@@ -6,7 +6,15 @@ from pathlib import Path
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.batch import FileRequest, done_lines, read_requests, summarize, summary_table
+from ara.eval.batch import (
+    FileRequest,
+    done_lines,
+    read_requests,
+    same_settings,
+    settings_path,
+    summarize,
+    summary_table,
+)
 from ara.eval.translator import TranslatorConfig
 
 from conftest import needs_llama, run_ara
@@ -78,6 +86,28 @@ def test_a_run_cut_off_mid_line_resumes_after_its_last_whole_answer(tmp_path):
     with pytest.raises(ConfigError, match="answers line 1 'never enter the lab' where the "
                                           "input has line 1 'go'"):
         done_lines(out, [FileRequest(1, "go", ("go",))], "m")
+
+
+def test_resume_refuses_an_output_made_with_other_settings(tmp_path):
+    """Tests that the settings are kept beside a new output, that the same settings
+    resume it, and that other ones are refused naming the setting that differs; an
+    output from before settings were kept resumes as it did."""
+    out = tmp_path / "answers.jsonl"
+    settings = {"model": "m", "answer": {"repair": {"samples": None, "by": "edits"}},
+                "shots": (1, 2)}
+    same_settings(out, settings)  # a new run keeps its settings
+    assert settings_path(out) == tmp_path / "answers.settings.json"
+    assert json.loads(settings_path(out).read_text())["answer"]["repair"]["by"] == "edits"
+    out.write_text('{"line": 1}\n', encoding="utf-8")
+    same_settings(out, settings)  # the same settings resume
+    other = {**settings, "answer": {"repair": {"samples": 0, "by": "edits"}}}
+    with pytest.raises(ConfigError, match=r"answers.jsonl was made with answer.repair.samples "
+                                          r"= null, this run has 0 .*pass the options it "
+                                          "was made with"):
+        same_settings(out, other)
+    settings_path(out).unlink()
+    same_settings(out, other)  # an output from before settings were kept
+    assert not settings_path(out).exists()
 
 
 def test_the_summary_counts_doubted_answers_and_matches_apart():

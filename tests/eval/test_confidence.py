@@ -33,11 +33,11 @@ def test_a_repaired_answer_is_scored_as_if_asked_anew(translator):
     """Tests that the winner's probability taken from repair's scores is the one scoring
     it afresh gives (a batch rounds differently from feeding a token at a time, so
     within 0.1 nats), on a request repair acts on."""
-    from ara.eval.consistency import translate_repaired
+    from ara.eval.consistency import RepairConfig, translate_repaired
 
     nl = "Bring pallet 8 to the loading dock within 250 steps and pallet 9 within 400 steps."
     aps = ("deliver_pallet_8", "deliver_pallet_9")
-    vote = translate_repaired(translator, nl, aps, samples=8)
+    vote = translate_repaired(translator, nl, aps, repair=RepairConfig(8))
     if len(vote.results) == 1:
         pytest.skip(f"the greedy answer {vote.result.stl} leaves nothing out: no repair")
     from_vote = winner_probability(translator, vote)

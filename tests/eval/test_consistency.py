@@ -10,6 +10,7 @@ from ara.errors import ConfigError
 from ara.eval.backends.base import BackendError, Sampling
 from ara.eval.checks import gaps
 from ara.eval.consistency import (
+    RepairConfig,
     Vote,
     _group,
     _missing,
@@ -117,19 +118,20 @@ def test_repair_draws_only_for_an_answer_with_a_gap(llama_backend):
     nl = "within 20 steps reach (prop_1), and never (prop_2)"
     greedy = t.translate(nl, aps)
     greedy_gaps = len(gaps(Request.of(nl, aps), parse(greedy.stl)))
-    vote = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
+    drawn = RepairConfig(3, "samples", temperature=1.0, seed=5)
+    vote = translate_repaired(t, nl, aps, repair=drawn)
     assert vote.answers[0] == greedy.stl
     assert len(vote.results) == (4 if greedy_gaps else 1)
     assert len(gaps(Request.of(nl, aps), parse(vote.result.stl))) <= greedy_gaps
-    again = translate_repaired(t, nl, aps, samples=3, temperature=1.0, seed=5, by="samples")
+    again = translate_repaired(t, nl, aps, repair=drawn)
     assert (again.answers, again.groups) == (vote.answers, vote.groups)
-    assert translate_repaired(t, nl, aps, samples=0).answers == (greedy.stl,)
-    with pytest.raises(ConfigError, match="samples must be >= 0"):
-        translate_repaired(t, nl, aps, samples=-1)
+    assert translate_repaired(t, nl, aps, repair=RepairConfig(0)).answers == (greedy.stl,)
+    with pytest.raises(ConfigError, match="repair draws 0 to 32 answers"):
+        RepairConfig(-1)
     with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
-        translate_repaired(t, nl, aps, by="votes")
+        RepairConfig(by="votes")
     with pytest.raises(ConfigError, match=r"doubt is a probability, 0 to 1 \(0: gaps only\)"):
-        translate_repaired(t, nl, aps, doubt=2)
+        RepairConfig(doubt=2)
 
 
 @needs_llama
@@ -146,7 +148,7 @@ def test_repair_by_score_keeps_the_best_scored_complete_answer(llama_backend, by
     left_out = gaps(Request.of(nl, aps), parse(greedy.stl))
     if not left_out:
         pytest.skip(f"the greedy answer {greedy.stl} leaves nothing out")
-    vote = translate_repaired(t, nl, aps, samples=3, by=by)
+    vote = translate_repaired(t, nl, aps, repair=RepairConfig(3, by))
     mends = literal_mends(t, Request.of(nl, aps), greedy.stl)
     drawn = 3 if by == "samples+edits" else 0
     assert vote.answers[0] == greedy.stl and vote.answers[1 + drawn:] == tuple(mends)
@@ -208,7 +210,7 @@ def test_repair_does_not_draw_for_a_bound_no_answer_can_write(llama_backend):
     the grammar could write it."""
     t = Translator(llama_backend, TranslatorConfig(intervals=False))
     nl, aps = "reach (prop_1) within 5 steps", ("prop_1",)
-    vote = translate_repaired(t, nl, aps, samples=3, doubt=0)  # gaps only
+    vote = translate_repaired(t, nl, aps, repair=RepairConfig(3, doubt=0))  # gaps only
     left_out = gaps(Request.of(nl, aps), parse(vote.answers[0]))
     assert left_out.numbers == (5,)
     assert len(vote.results) == (4 if left_out.count(timed=False) else 1)
@@ -220,12 +222,14 @@ def test_repair_searches_again_only_where_the_model_doubts_a_complete_answer(fin
     samples drawn, and the best-scored complete answer wins, never one the model scores
     lower than the greedy answer."""
     t = Translator(finetuned)
-    sure = translate_repaired(t, "at no time ( prop_1 )", ("prop_1",), samples=4)
+    sure = translate_repaired(t, "at no time ( prop_1 )", ("prop_1",),
+                              repair=RepairConfig(4))
     assert sure.answers == ("G(!prop_1)",) and math.exp(sure.scores[0]) > 0.9
     nl, aps = "( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2")
-    doubted = translate_repaired(t, nl, aps, samples=4, doubt=0.5)
+    doubted = translate_repaired(t, nl, aps, repair=RepairConfig(4, doubt=0.5))
     assert len(doubted.answers) == 5 and not gaps(Request.of(nl, aps), parse(doubted.answers[0]))
     assert math.exp(doubted.scores[0]) < 0.5
     best = max(s for s in doubted.scores if s is not None)
     assert doubted.scores[doubted.groups[0][0]] == best >= doubted.scores[0]
-    assert translate_repaired(t, nl, aps, samples=4, doubt=0).answers == doubted.answers[:1]
+    gaps_only = RepairConfig(4, doubt=0)
+    assert translate_repaired(t, nl, aps, repair=gaps_only).answers == doubted.answers[:1]

@@ -104,13 +104,13 @@ def test_repair_puts_back_a_bound_the_sentence_states(finetuned, by):
     those one edit away that write 250 is right; by samples, the answers drawn that use
     every stated bound agree on it."""
     from ara.eval.checks import gaps
-    from ara.eval.consistency import translate_repaired
+    from ara.eval.consistency import RepairConfig, translate_repaired
     from ara.eval.request import Request
     from ara.grammars import parse
 
     nl = "Bring pallet 8 to the loading dock within 250 steps and pallet 9 within 400 steps."
     aps = ("deliver_pallet_8", "deliver_pallet_9")
-    vote = translate_repaired(Translator(finetuned), nl, aps, samples=8, by=by)
+    vote = translate_repaired(Translator(finetuned), nl, aps, repair=RepairConfig(8, by))
     greedy_gaps = gaps(Request.of(nl, aps), parse(vote.answers[0]))
     if by == "samples":
         assert len(vote.results) == (9 if greedy_gaps else 1)

@@ -3,6 +3,7 @@
 import pytest
 
 from ara.errors import ConfigError
+from ara.eval.consistency import RepairConfig
 from ara.eval.harness import AblationConfig, Variant, plan
 
 
@@ -42,35 +43,39 @@ def test_config_round_trips_and_refuses_unknown_keys():
 
 def test_repair_is_recorded_only_when_on_so_older_runs_still_resume():
     """Tests that a run without repair writes the config runs wrote before repair
-    existed (a resumed run must match it), and that repair round-trips and is bounded."""
+    existed (a resumed run must match it), that repair is saved flat as before, and
+    that it round-trips and is bounded."""
     assert not {"repair", "repair_by", "repair_doubt"} & set(AblationConfig().to_dict())
-    repaired = AblationConfig(repair=8)
-    assert AblationConfig.from_dict(repaired.to_dict()) == repaired
-    assert repaired.repair_by == "samples+edits"
-    with pytest.raises(ConfigError, match="repair from 0 to 32"):
-        AblationConfig(repair=33)
+    repaired = AblationConfig(repair=RepairConfig(8))
+    saved = repaired.to_dict()
+    assert (saved["repair"], saved["repair_by"], saved["repair_doubt"]) == (8, "samples+edits",
+                                                                            0.5)
+    assert AblationConfig.from_dict(saved) == repaired
+    with pytest.raises(ConfigError, match="repair draws 0 to 32 answers"):
+        AblationConfig(repair=RepairConfig(33))
     with pytest.raises(ConfigError, match=r"choose one of samples\+edits, edits, samples"):
-        AblationConfig(repair=8, repair_by="votes")
-    with pytest.raises(ConfigError, match="repair_doubt is a probability, 0 to 1; got 1.5"):
-        AblationConfig(repair=8, repair_doubt=1.5)
+        AblationConfig(repair=RepairConfig(8, by="votes"))
+    with pytest.raises(ConfigError, match=r"doubt is a probability, 0 to 1 \(0: gaps only\); "
+                                          "got 1.5"):
+        AblationConfig(repair=RepairConfig(8, doubt=1.5))
 
 
 def test_a_run_repaired_before_edits_existed_reads_as_repaired_by_samples():
     """Tests that a run folder written when repair only sampled keeps saying so, so that
     resuming it with repair by edits is refused instead of mixing the two."""
-    old = AblationConfig(repair=8).to_dict()
+    old = AblationConfig(repair=RepairConfig(8)).to_dict()
     del old["repair_by"], old["repair_doubt"]
-    assert AblationConfig.from_dict(old).repair_by == "samples"
+    assert AblationConfig.from_dict(old).repair.by == "samples"
 
 
 def test_a_run_repaired_before_doubt_existed_reads_as_repairing_gaps_only():
     """Tests that a run folder written when repair acted on gaps alone keeps saying so
     (doubt 0), so that resuming it under the default, which also acts on answers the
     model doubts, is refused instead of mixing the two."""
-    old = AblationConfig(repair=8).to_dict()
+    old = AblationConfig(repair=RepairConfig(8)).to_dict()
     del old["repair_doubt"]
-    assert AblationConfig.from_dict(old).repair_doubt == 0.0
-    assert AblationConfig(repair=8).repair_doubt == 0.5
+    assert AblationConfig.from_dict(old).repair.doubt == 0.0
+    assert AblationConfig(repair=RepairConfig(8)).repair.doubt == 0.5
 
 
 def test_plan_covers_every_variant_shot_and_rerun_once(paper_split):
