@@ -240,6 +240,7 @@ def test_translate_notes_an_answer_the_model_doubts():
 
 
 @needs_llama
+@pytest.mark.slow  # doubt's note: test_translate_notes_an_answer_the_model_doubts
 def test_a_doubted_answer_comes_with_the_other_readings_the_model_weighed():
     """Tests --alternatives on a sentence whose scope the model hesitates over: each
     other reading means something else than the answer, the model gives it no more

@@ -15,7 +15,8 @@ from conftest import needs_llama
 
 
 @needs_llama
-@pytest.mark.parametrize("name", ["kitting", pytest.param("tool", marks=pytest.mark.slow)])
+@pytest.mark.slow  # the help request's real round trip runs by default in test_protocol
+@pytest.mark.parametrize("name", ["kitting", "tool"])
 def test_an_errand_is_translated_repaired_and_its_gaps_reported(name, tmp_path, finetuned):
     """Tests the demo's translation path: the formula it plans from is the repaired
     translation, a warning names anything it still leaves out, and a note follows a

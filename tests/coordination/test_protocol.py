@@ -91,9 +91,9 @@ def test_a_helper_over_its_cap_declines_with_a_reason():
 
 
 @pytest.mark.llm
-def test_round_trip_with_the_embedded_llm(llama_backend):
+def test_round_trip_with_the_embedded_llm(llama_backend, finetuned):
     """The embedded model writes the request under a grammar that keeps its fields,
-    and each helper plans whatever formula the same translator makes of it."""
+    and each helper plans whatever formula the shipped translator makes of it."""
     from ara.coordination.protocol import generate_request
     from ara.eval.translator import Translator
     from ara.grammars import parse
@@ -102,7 +102,7 @@ def test_round_trip_with_the_embedded_llm(llama_backend):
     assert request_site(text) == (3, 4) and "I can only navigate, report conflicts." in text
     req = HelpRequest("requester", (3, 4), CAPS, text)
     helpers = [Helper(0, (0, 0), ()), Helper(1, (7, 7), (Job((7, 6), (0, 6)),))]
-    rnd = run_round(WORLD, req, helpers, planner="milp", translator=Translator(llama_backend))
+    rnd = run_round(WORLD, req, helpers, planner="milp", translator=Translator(finetuned))
     for offer in rnd.offers:
         assert offer.stl and parse(offer.stl)  # logged, and in the language
         assert offer.can_help or offer.reason

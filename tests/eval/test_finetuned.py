@@ -96,8 +96,9 @@ def test_names_reach_every_shipped_adapter(finetuned, tmp_path):
         make_backend(f"lora:{tmp_path / 'missing.gguf'}")
 
 
-@pytest.mark.parametrize("by", [  # samples: another 9 answers, for the draws' count
-    "samples+edits", "edits", pytest.param("samples", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("by", [  # the draws' ways are slow: repair by edits runs by default
+    pytest.param("samples+edits", marks=pytest.mark.slow), "edits",
+    pytest.param("samples", marks=pytest.mark.slow)])
 def test_repair_puts_back_a_bound_the_sentence_states(finetuned, by):
     """Tests `ara translate`'s repair on a hand-written instruction whose greedy answer
     gives both pallets the later deadline: by edits, the model's best-scored answer of

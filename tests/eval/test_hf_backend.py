@@ -9,6 +9,7 @@ from ara.eval.prompt import STOP, build_prompt, sample_shots
 from ara.eval.translator import Translator
 
 
+@pytest.mark.slow  # test_decoding_sums_the_log_probability_scoring_gives decodes under the grammar
 def test_constrained_outputs_belong_to_the_language(hf_backend, paper_split):
     """Tests the guarantee through transformers + llguidance on real generations."""
     translator = Translator(hf_backend)
@@ -66,9 +67,9 @@ def test_transformers_and_llama_cpp_score_answers_alike(hf_backend, llama_backen
 
 
 def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backend):
-    """Tests that a completion's log-probability, summed while decoding under the
-    grammar, is what scoring its text gives, in both runtimes (the free check `ara
-    translate` runs on every answer)."""
+    """Tests that a completion decoded under the grammar is in the language, and that
+    its log-probability, summed while decoding, is what scoring its text gives, in both
+    runtimes (the free check `ara translate` runs on every answer)."""
     from ara.data import load_or_prepare
     from ara.eval.translator import decoding_grammar
 
@@ -81,6 +82,7 @@ def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backe
     for backend in (hf_backend, llama_backend):
         grammar = decoding_grammar(Translator(backend).grammar(aps, nl))
         completion = backend.complete(prompt, grammar, 64, STOP)
+        assert Translator(backend).grammar(aps, nl).syntax.accepts(completion.text.strip())
         assert completion.logprob is not None, completion.text  # the tokenizer's own tokens
         assert completion.logprob == pytest.approx(backend.score(prompt, [completion.text])[0],
                                                    abs=0.5)

@@ -90,6 +90,7 @@ def test_an_answer_can_be_required_to_write_what_the_request_lists(llama_backend
         translator.translate(nl, aps, require=("7",))
 
 
+@pytest.mark.slow  # a speed-up's equivalence; generation under the grammar runs in the default tier
 def test_prefix_reuse_changes_nothing_but_the_work(llama_backend, embedded_model_path,
                                                    paper_split):
     """Tests that a prompt sharing its prefix with the previous one gets exactly what a

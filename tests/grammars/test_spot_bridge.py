@@ -107,8 +107,9 @@ def test_brute_force_and_spot_agree_on_random_timed_formulas():
             assert accepts_word(f, list(word.prefix), list(word.loop), ("a", "b")) == holds(f, word)
 
 
-@pytest.mark.parametrize("text", ["F[250,520](a)", "G[200,300](!a)", "b U[240,260] a",
-                                  "F[600,inf](a)", "G[0,254](!a)"])
+@pytest.mark.parametrize("text", [  # the two slowest checks are in the slow tier
+    pytest.param("F[250,520](a)", marks=pytest.mark.slow), "G[200,300](!a)",
+    pytest.param("b U[240,260] a", marks=pytest.mark.slow), "F[600,inf](a)", "G[0,254](!a)"])
 def test_bounds_past_spots_repetition_limit_stay_exact(text):
     """Tests the chained encoding of bounds above 254 against brute force, at the seams."""
     f = parse(text)

@@ -55,6 +55,7 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
         LoRAFinetuneRecipe(changed, resume=True)
 
 
+@pytest.mark.slow  # the harness runs a real model by default (test_resume_after_kill)
 def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path):
     """Tests the saved adapter and the held-out check, with prompts of 0 and 2 worked
     examples: even random weights give valid formulas under the grammar."""
@@ -72,6 +73,7 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
     assert report["validity"] == 1.0
 
 
+@pytest.mark.slow  # the default tier warm-starts a stage in test_stage_runner
 def test_a_warm_start_continues_from_a_finished_adapter(tiny_gemma_dir, tmp_path):
     """Tests ``init_adapter``: a second run starting from the first run's adapter begins
     at the loss the first run ended with (the same batch), not at a fresh LoRA's."""
@@ -148,6 +150,7 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
     assert np.corrcoef(ours, theirs)[0, 1] > 0.999
 
 
+@pytest.mark.slow  # a speed-up's equivalence; the golden losses pin training in the default tier
 def test_sharing_the_prompt_prefix_gives_the_same_loss_and_gradients(tiny_gemma_dir):
     """The instructions every prompt starts with run once per batch; loss and LoRA
     gradients must match a plain forward over the whole batch."""
@@ -196,6 +199,7 @@ def test_two_steps_reproduce_the_golden_losses(tiny_gemma_dir, tmp_path):
     assert recipe.train() == pytest.approx(golden["losses"], rel=1e-4)
 
 
+@pytest.mark.slow  # the golden losses pin a step of the default tier's training
 def test_a_step_of_several_micro_batches_logs_all_of_them(tiny_gemma_dir, tmp_path):
     """With grad_accum 2, one logged step covers both micro-batches (their shot counts,
     their summed tokens and time, their mean loss), not the last one alone."""
@@ -212,6 +216,7 @@ def test_a_step_of_several_micro_batches_logs_all_of_them(tiny_gemma_dir, tmp_pa
     assert [x["loss"] for x in log] == [round(v, 5) for v in losses]
 
 
+@pytest.mark.slow  # an edge of merging; export and merge run in the default tier's stage runner
 def test_merging_an_adapter_saved_without_a_tokenizer_takes_the_bases(tiny_gemma_dir, tmp_path):
     """A soup of committed adapters has no tokenizer beside it (runs save one, the
     committed records do not): the merged folder gets the base model's, so that
