@@ -15,6 +15,9 @@ from ara.grammars.cli import grammar_cmd, stl_app
 from ara.training.cli import export_cmd, model_app, soup_cmd, train_cmd
 
 app = typer.Typer(
+    # Plain help: rich's panels wrap each option's help into a narrow column, several
+    # screens for ara translate.
+    rich_markup_mode=None,
     help="ask-reason-assist: natural language to Signal Temporal Logic with guaranteed "
          "syntax, for multi-robot help requests.",
     no_args_is_help=True,

@@ -16,59 +16,83 @@ from ara.eval.consistency import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
 
-MODEL_HELP = ("default (embedded Gemma 3 270M), finetuned (its shipped LoRA), lora:ADAPTER.gguf "
-              "(another LoRA on the same base), a .gguf path, hf:FOLDER, or an "
-              "OpenAI-compatible http(s):// endpoint")
-SERVER_HELP = ("With an http(s):// --model: the server that runs it, which says where it reads "
-               "the grammar for constrained decoding: llama (llama.cpp, llama-cpp-python), "
-               "vllm, sglang, or openai (no grammar; constrained variants are refused).")
+MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), default (without), "
+              "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint")
+SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
+               "llama, vllm, sglang, or openai (none: constrained decoding is refused).")
 
 
 # The options ``ara translate`` and ``ara translate-file`` share, defined once.
 MODEL = typer.Option("finetuned", "--model", help=MODEL_HELP)
 SHOTS = typer.Option(
     None, "--shots", min=0, max=50,
-    help="Worked examples from the compositional train side; default 0 for the "
-         "fine-tuned adapters, 5 for other models.")
+    help="Worked examples in the prompt; default 0 for the fine-tuned adapters, 5 for "
+         "other models.")
 SEED = typer.Option(0, "--seed", help="Which worked examples, and the samples' seeds.")
 EXAMPLES_BY = typer.Option(
     "random", "--examples-by",
-    help="How the --shots worked examples are chosen: random (drawn with --seed, the same "
-         "for every request) or similar (the pool's pairs whose wording is most like the "
-         "request's, its propositions' own words aside).")
+    help="random (drawn with --seed) or similar (the pool's pairs worded most like the "
+         "request, its propositions' words aside).")
 EXAMPLES = typer.Option(
     None, "--examples", dir_okay=False, exists=True,
-    help="A file of your own pairs to take worked examples from (JSON Lines as "
-         "translate-file reads, each line with its reference \"stl\"); default: the "
-         "training mixture. Use with --shots and --examples-by similar.")
+    help="Your own pairs to take worked examples from (JSON Lines, each with \"stl\"); "
+         "default: the training mixture.")
 INTERVALS = typer.Option(
     True, "--intervals/--no-intervals",
-    help="Allow time bounds (F[a,b], G[a,b], U[a,b]); on by default, and an untimed "
-         "sentence still comes out untimed.")
+    help="Allow time bounds (F[a,b], G[a,b], U[a,b]); an untimed sentence stays untimed.")
 MAX_BOUND = typer.Option(1000, "--max-bound", min=1,
                          help="Largest time bound the grammar admits.")
 ANY_BOUND = typer.Option(
     False, "--any-bound",
-    help="Let intervals use any number up to --max-bound; by default they use only 0 "
-         "and the numbers the sentence writes (digits, or words up to 'hundred').")
+    help="Let bounds be any number up to --max-bound, not only 0 and the sentence's own.")
 # Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
 TEMPERATURE = typer.Option(0.7, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
-                             f"{DEFAULT_REPAIR}, or 0 with --samples; 0: off.")
+                             f"{DEFAULT_REPAIR} (0 where answers are voted); 0: off.")
 REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])
 DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
-    help="When the model doubts its answer, list up to this many other readings it "
-         "weighed (distinct meanings of the answers repair drew, best-scored first), "
-         "each read back in English. 0: none.")
+    help="Other readings the model weighed to list when it doubts its answer.")
 SERVER = typer.Option("openai", "--server", help=SERVER_HELP)
 
 
+AS_JSON = typer.Option(False, "--json", help="Print one JSON object.")
+APS = typer.Option(..., "--aps", help="Comma-separated propositions, each named in the "
+                   "sentence (go_to_kitchen: 'go to the kitchen').")
+NL = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'.")
+
+
 def translate_cmd(
-    nl: str = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'."),
-    aps: str = typer.Option(..., "--aps", help="Comma-separated atomic propositions, each "
-                            "named in the sentence (go_to_kitchen: 'go to the kitchen')."),
+    nl: str = NL,
+    aps: str = APS,
+    model: str = MODEL,
+    shots: int | None = SHOTS,
+    examples_by: str = EXAMPLES_BY,
+    examples: Path | None = EXAMPLES,
+    seed: int = SEED,
+    intervals: bool = INTERVALS,
+    max_bound: int = MAX_BOUND,
+    any_bound: bool = ANY_BOUND,
+    repair: int | None = REPAIR_OPTION,
+    alternatives: int = ALTERNATIVES,
+    server: str = SERVER,
+    as_json: bool = AS_JSON,
+) -> None:
+    """Translate one instruction into STL over the given propositions.
+
+    Prints the formula; on stderr, a warning when it leaves part of the request
+    out, and the other readings when the model doubts it (docs/model-card.md).
+    The knobs of experiments are in `ara eval translate`.
+    """
+    _translate(nl, aps, model, shots, examples_by, examples, seed, intervals, max_bound,
+               any_bound, repair=repair, alternatives=alternatives, server=server,
+               as_json=as_json)
+
+
+def eval_translate_cmd(
+    nl: str = NL,
+    aps: str = APS,
     model: str = MODEL,
     no_constraint: bool = typer.Option(False, "--no-constraint",
                                        help="Decode freely instead of under the grammar."),
@@ -91,30 +115,28 @@ def translate_cmd(
     doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,
     server: str = SERVER,
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    as_json: bool = AS_JSON,
 ) -> None:
-    """Translate one instruction into STL over the given propositions.
+    """`ara translate` with every knob of the experiments: self-consistency votes,
+    the way repair searches, unconstrained decoding, the grammar in the prompt."""
+    _translate(nl, aps, model, shots, examples_by, examples, seed, intervals, max_bound,
+               any_bound, samples=samples, repair=repair, repair_by=repair_by, doubt=doubt,
+               temperature=temperature, grammar_in_prompt=grammar_in_prompt,
+               constrained=not no_constraint, alternatives=alternatives, server=server,
+               as_json=as_json)
 
-    Prints the formula. On stderr: a warning when it still has a gap after
-    repair (see --repair: a listed proposition, a stated bound, an asked-for order
-    or 'always' / 'at some point' / 'again and again' left out, or operators
-    nested unasked), and a note with the formula read back in
-    English when the model gives its answer a probability below 0.5, with
-    the other readings it weighed. --json has them as "left_out", "unasked",
-    "confidence" and "alternatives". How often such answers are wrong:
-    docs/model-card.md.
-    """
+
+def _translate(nl: str, aps: str, model: str, shots: int | None, examples_by: str,
+               examples: Path | None, seed: int, intervals: bool, max_bound: int,
+               any_bound: bool, server: str, as_json: bool, **how) -> None:
     from ara.api import translate
     from ara.eval.answering import notes
 
     with user_errors():  # the same path as ara.translate from Python
         answer = translate(nl, split_list(aps), model, shots=shots, seed=seed,
-                         examples_by=examples_by, examples=examples,
-                         intervals=intervals, max_bound=max_bound, any_bound=any_bound,
-                         server=server, samples=samples, repair=repair, repair_by=repair_by,
-                         doubt=doubt, temperature=temperature,
-                         grammar_in_prompt=grammar_in_prompt, constrained=not no_constraint,
-                         alternatives=alternatives)
+                           examples_by=examples_by, examples=examples,
+                           intervals=intervals, max_bound=max_bound, any_bound=any_bound,
+                           server=server, **how)
     for note in [] if as_json else notes(answer, nl):  # JSON users read the fields
         typer.echo(note, err=True)
     r = answer.result
@@ -221,6 +243,9 @@ def translate_file_cmd(
     lines = [json.loads(line) for line in out.read_text(encoding="utf-8").splitlines()]
     summary = summarize(lines)
     emit(summary, as_json, lambda s: summary_table(s) + f"\n\nanswers in {out}")
+
+
+eval_app.command("translate")(eval_translate_cmd)
 
 
 @eval_app.command("ablation")

@@ -46,12 +46,9 @@ REPAIR_BY = ("samples+edits", "edits", "samples")
 #: The help of each repair option, shared by ``ara translate``, ``translate-file`` and
 #: ``ara eval ablation``; each command adds its own default for ``samples``.
 REPAIR_HELP = {
-    "samples": "When the greedy answer has a gap (it leaves out a proposition in --aps, a "
-               "number the sentence states as time, an order it asks for with 'then', or "
-               "an 'always', 'at some point' or 'again and again' it asks for in words; or "
-               "it nests F and G or orders steps where the sentence has no words for "
-               "that), look for an answer with fewer gaps (a greedy answer with none costs "
-               "nothing more), drawing K answers under the grammar (see --repair-by).",
+    "samples": "K answers to draw when the first leaves part of the request out (a "
+               "proposition, a stated bound, an order, an 'always' or 'at some point') or "
+               "the model doubts it; one with fewer gaps wins.",
     "by": "samples+edits: the K answers drawn and the formulas one edit from the greedy "
           "answer that close a gap; the one the model scores highest of those with the "
           "fewest gaps wins. edits: the edits alone. samples: the majority of the K drawn "

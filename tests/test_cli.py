@@ -117,12 +117,21 @@ def test_eval_ceiling_on_an_ablation_sample(paper_split):
     [[], ["stl"], ["stl", "parse"], ["stl", "equiv"], ["stl", "implies"], ["grammar"],
      ["data"], ["data", "prepare"], ["data", "stats"], ["data", "export"], ["demo"],
      ["coord"], ["coord", "exp2"], ["coord", "demo"], ["coord", "plan"],
-     ["eval", "ceiling"]],
+     ["eval", "ceiling"], ["eval", "translate"]],
 )
 def test_every_command_explains_itself(command):
     """Tests that --help works everywhere and says something."""
     result = runner.invoke(app, command + ["--help"], env={**os.environ, "COLUMNS": "120"})
     assert result.exit_code == 0 and "Usage" in result.output and len(result.output) > 200
+
+
+def test_translate_help_fits_one_screen_and_leaves_the_experiments_knobs_to_eval():
+    help_text = runner.invoke(app, ["translate", "--help"], terminal_width=80).output
+    assert len(help_text.splitlines()) <= 60 and "ara eval translate" in help_text
+    assert "--repair-by" not in help_text and "--samples" not in help_text
+    knobs = runner.invoke(app, ["eval", "translate", "--help"], terminal_width=80).output
+    assert all(knob in knobs for knob in ("--repair-by", "--doubt", "--samples",
+                                          "--no-constraint", "--grammar-in-prompt"))
 
 
 @pytest.mark.parametrize("name", ["pallet", "kitting", "tool"])
@@ -176,19 +185,21 @@ def test_explain_reads_a_formula_back_in_english():
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["", "--aps", "a"], "the instruction is empty"),
-        (["go to the kitchen", "--aps", "go_to_kitchen,pick_red_box"],
+        (["translate", "", "--aps", "a"], "the instruction is empty"),
+        (["translate", "go to the kitchen", "--aps", "go_to_kitchen,pick_red_box"],
          "never mentions pick_red_box"),  # a proposition the sentence never names
-        (["reach prop_1 within 5000 steps", "--aps", "prop_1"], "pass --max-bound 5000"),
-        (["always (prop_1)", "--aps", "prop_1", "--samples", "3", "--repair", "2"],
-         "pass one"),
-        (["always (prop_1)", "--aps", "prop_1", "--repair-by", "votes"],
+        (["translate", "reach prop_1 within 5000 steps", "--aps", "prop_1"],
+         "pass --max-bound 5000"),
+        (["eval", "translate", "always (prop_1)", "--aps", "prop_1", "--samples", "3",
+          "--repair", "2"], "pass one"),
+        (["eval", "translate", "always (prop_1)", "--aps", "prop_1", "--repair-by", "votes"],
          "--repair-by 'votes'? choose one of samples+edits, edits, samples"),
     ],
 )
 def test_translate_refuses_a_request_it_cannot_honour(args, message):
-    """Tests that bad translation requests exit 2 with the fix, before any model loads."""
-    out = ara("translate", *args)
+    """Tests that bad translation requests exit 2 with the fix, before any model loads
+    (the experiments' knobs are `ara eval translate`'s)."""
+    out = ara(*args)
     assert out.returncode == 2 and message in out.stderr and "Traceback" not in out.stderr
 
 

@@ -18,14 +18,15 @@ WORDS = ["--json", "--aps", "a,b", "a", "", ",,", "1", "-1", "99999", "--shots",
          "--no-intervals", "--any-bound", "--samples", "0", "--temperature", "-3", "--repair",
          "--model", "no-such-model", "lora:missing.gguf", "--world", "/nonexistent"]
 COMMANDS = [["stl", "parse"], ["stl", "explain"], ["stl", "equiv"], ["stl", "implies"],
-            ["coord", "plan"], ["data", "stats"], ["data", "prepare"], ["translate"]]
+            ["coord", "plan"], ["data", "stats"], ["data", "prepare"], ["translate"],
+            ["eval", "translate"]]
 
 
 def invocation(rng: random.Random) -> list[str]:
     command = rng.choice(COMMANDS)
     args = [rng.choice(FORMULAS) for _ in range(rng.randint(0, 2))]
     args += [rng.choice(WORDS) for _ in range(rng.randint(0, 5))]
-    if command == ["translate"]:
+    if command[-1] == "translate":
         # Never a valid model with valid propositions: that would load a model per case,
         # and the valid path has its own tests.
         args += ["--model", rng.choice(["no-such-model", "lora:missing.gguf"])]
