@@ -46,7 +46,8 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
             training mixture), as ``--examples-by`` and ``--examples``.
         **how: ``ara translate``'s other options, as :meth:`AnswerConfig.of
             <ara.eval.answering.AnswerConfig.of>` names them (``repair``, ``repair_by``,
-            ``samples``, ``doubt``, ``alternatives``, ...).
+            ``samples``, ``doubt``, ``alternatives``, ``budget_s``: seconds for the whole
+            answer, ``--budget``, ...).
 
     Returns:
         The answer: ``stl`` (``None`` if the model wrote no formula), ``confidence``,

@@ -27,6 +27,7 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
+from ara.eval.deadline import Deadline
 from ara.eval.prompt import Shot, sample_shots
 from ara.eval.request import Request
 from ara.eval.translator import TranslationResult, Translator
@@ -36,6 +37,10 @@ from ara.grammars import parse
 #: is listed as two. Long formulas with bounds in the hundreds can take minutes, and a
 #: user waits for this list.
 SAME_READING_TIMEOUT_S = 2.0
+
+#: Seconds an answer may take by default before repair, its Spot checks and the other
+#: readings stop and the best answer found so far is given.
+BUDGET_S = 5.0
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,10 @@ class AnswerConfig:
         grammar_in_prompt: Show the grammar in the prompt.
         constrained: Decode under the grammar.
         alternatives: Other readings to report when the model doubts its answer, 0 to 8.
+        budget_s: Seconds for the whole answer (:class:`~ara.eval.deadline.Deadline`):
+            once spent, repair draws, mends and scores no more answers, Spot checks
+            stop and the greedy answer (or a better one already scored) is given. >= 0;
+            0 or ``None``: unbounded.
     """
 
     samples: int = 1
@@ -58,6 +67,7 @@ class AnswerConfig:
     grammar_in_prompt: bool = False
     constrained: bool = True
     alternatives: int = 2
+    budget_s: float | None = BUDGET_S
 
     def __post_init__(self) -> None:
         if not 1 <= self.samples <= 32:
@@ -72,6 +82,10 @@ class AnswerConfig:
             raise ConfigError("--repair decodes under the grammar; drop --no-constraint")
         if not 0 <= self.alternatives <= 8:
             raise ConfigError(f"alternatives must be 0 to 8, got {self.alternatives}")
+        if self.budget_s is not None and not 0 <= self.budget_s < math.inf:
+            raise ConfigError(f"the budget is seconds per answer, >= 0 (0: unbounded); got "
+                              f"{self.budget_s}")
+        object.__setattr__(self, "budget_s", self.budget_s or None)  # one way to say none
 
     @classmethod
     def of(cls, samples: int = 1, repair: int | None = None, repair_by: str = REPAIR_BY[0],
@@ -104,6 +118,13 @@ class Answer:
         gaps: What the answer leaves out of the request or nests unasked
             (:class:`~ara.eval.checks.Gaps`); ``None`` where it does not parse, or
             nobody asked.
+        waited_ms: The whole time :func:`answer` took (generation, scoring, readings,
+            gap checks); ``None`` where the answer was made otherwise.
+        budget_s: The time budget it was given; ``None``: unbounded.
+        ran_out: Whether the budget ran out before the search was done (a draw, mend,
+            score, Spot check or reading was skipped or cut short), so that an unbounded
+            answer may differ; not where nothing was left to do (a greedy answer slower
+            than the budget, with no gap and no doubt).
     """
 
     result: TranslationResult
@@ -112,6 +133,9 @@ class Answer:
     confidence: float | None = None
     alternatives: tuple[tuple[str, float], ...] = ()
     gaps: Gaps | None = None
+    waited_ms: float | None = None
+    budget_s: float | None = None
+    ran_out: bool = False
 
     @property
     def stl(self) -> str | None:
@@ -120,7 +144,10 @@ class Answer:
 
     @property
     def ms(self) -> float:
-        """Wall time of every generation and check, in milliseconds."""
+        """The time a user waited for the answer, in milliseconds: :attr:`waited_ms`, else
+        that of every generation and check."""
+        if self.waited_ms is not None:
+            return self.waited_ms
         return self.vote.ms if self.vote else self.result.ms
 
     @property
@@ -130,14 +157,16 @@ class Answer:
 
     def to_json(self) -> dict:
         """The ``--json`` object of ``ara translate``: ``stl``, ``valid``, ``raw``, ``ms``
-        (all generations), ``error``, ``model``, ``constrained``, ``shots``, ``grammar``;
+        (the whole answer), ``budget`` (``s``, the seconds given, ``null``: unbounded;
+        ``ran_out``), ``error``, ``model``, ``constrained``, ``shots``, ``grammar``;
         ``samples`` (every answer, their groups and scores) where more than one was
         weighed; ``confidence``; ``alternatives`` (each ``stl`` and ``probability``);
         ``left_out`` and ``unasked`` (:meth:`~ara.eval.checks.Gaps.to_json`) where the
         answer parses."""
         r, vote = self.result, self.vote
         data = {"stl": r.stl, "valid": r.valid, "raw": r.raw, "ms": round(self.ms, 1),
-                "error": r.error, "model": self.model, "constrained": r.constrained,
+                "budget": {"s": self.budget_s, "ran_out": self.ran_out}, "error": r.error,
+                "model": self.model, "constrained": r.constrained,
                 "shots": r.shots, "grammar": r.grammar}
         if vote is not None:
             data["samples"] = {"answers": list(vote.answers),
@@ -155,19 +184,23 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
            config: AnswerConfig | None = None) -> Answer:
     """Translate ``nl`` over ``aps`` as ``config`` says, with what a user should know: the
     model's confidence, the other readings where it doubts the answer
-    (:data:`DOUBT`), and the answer's gaps (:func:`~ara.eval.checks.gaps`)."""
+    (:data:`DOUBT`), and the answer's gaps (:func:`~ara.eval.checks.gaps`), all within
+    ``config.budget_s`` (:class:`~ara.eval.deadline.Deadline`)."""
     config = config or AnswerConfig()
+    deadline = Deadline(config.budget_s)
     vote: Vote | None = None
     repair = config.repair
     if config.samples > 1:
         vote = translate_consistent(translator, nl, aps, shots, config.samples,
                                     repair.temperature, repair.seed,
-                                    grammar_in_prompt=config.grammar_in_prompt)
+                                    grammar_in_prompt=config.grammar_in_prompt,
+                                    deadline=deadline)
         result = vote.result
     elif config.repairs:
         vote = translate_repaired(translator, nl, aps, shots,
                                   replace(repair, samples=config.repairs),
-                                  grammar_in_prompt=config.grammar_in_prompt)
+                                  grammar_in_prompt=config.grammar_in_prompt,
+                                  deadline=deadline)
         result = vote.result
     else:
         result = translator.translate(nl, aps, shots, config.grammar_in_prompt,
@@ -181,9 +214,10 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
         # The winner is scored whenever anything is, so the first reading is its.
         others = tuple((stl, _significant(math.exp(score)))
                        for stl, score in readings(vote, SAME_READING_TIMEOUT_S,
-                                                  limit=1 + config.alternatives)[1:])
+                                                  1 + config.alternatives, deadline)[1:])
     found = None if result.stl is None else gaps(Request.of(nl, aps), parse(result.stl))
-    return Answer(result, translator.backend.model_id, vote, confidence, others, found)
+    return Answer(result, translator.backend.model_id, vote, confidence, others, found,
+                  deadline.elapsed_ms, config.budget_s, deadline.ran_out)
 
 
 def _significant(p: float) -> float:
@@ -240,12 +274,17 @@ def _pool_file(path: str) -> tuple:
 
 
 def notes(answer: Answer, nl: str = "") -> list[str]:
-    """What to tell a user about an answer, as ``ara translate`` prints it on stderr: what
-    it leaves out of the request (quoting the words of ``nl`` that ask for it), and, if
-    the model doubts it, the answer read back with the other readings it weighed."""
+    """What to tell a user about an answer, as ``ara translate`` prints it on stderr:
+    whether its time budget ran out, what it leaves out of the request (quoting the words
+    of ``nl`` that ask for it), and, if the model doubts it, the answer read back with
+    the other readings it weighed."""
     if answer.stl is None:
         return []
     said = []
+    if answer.ran_out:
+        said.append(f"note: the time budget of {answer.budget_s:g} s ran out before the search "
+                    "for a better answer was done; this is the best found by then (--budget "
+                    "sets it, 0: no limit)")
     if answer.gaps:
         said.append(answer.gaps.warning(Request.of(nl, ())))  # no aps here: read nl whole
     if doubted(answer.confidence):

@@ -10,6 +10,7 @@ import typer
 
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
+from ara.eval.answering import BUDGET_S
 from ara.eval.confidence import DOUBT
 from ara.eval.consistency import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 
@@ -55,6 +56,11 @@ ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
     help="Other readings the model weighed to list when it doubts its answer.")
 SERVER = typer.Option("openai", "--server", help=SERVER_HELP)
+# Checked by AnswerConfig, as the repair options are by RepairConfig.
+BUDGET = typer.Option(
+    BUDGET_S, "--budget", metavar="SECONDS",
+    help="Time for the whole answer; when it runs out, repair stops and the best answer "
+         "found so far is given. 0: no limit.")
 
 
 AS_JSON = typer.Option(False, "--json", help="Print one JSON object.")
@@ -76,6 +82,7 @@ def translate_cmd(
     any_bound: bool = ANY_BOUND,
     repair: int | None = REPAIR_OPTION,
     alternatives: int = ALTERNATIVES,
+    budget: float = BUDGET,
     server: str = SERVER,
     as_json: bool = AS_JSON,
 ) -> None:
@@ -86,8 +93,8 @@ def translate_cmd(
     The knobs of experiments are in `ara eval translate`.
     """
     _translate(nl, aps, model, shots, examples_by, examples, seed, intervals, max_bound,
-               any_bound, repair=repair, alternatives=alternatives, server=server,
-               as_json=as_json)
+               any_bound, repair=repair, alternatives=alternatives, budget_s=budget,
+               server=server, as_json=as_json)
 
 
 def eval_translate_cmd(
@@ -114,6 +121,7 @@ def eval_translate_cmd(
     repair_by: str = REPAIR_BY_OPTION,
     doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,
+    budget: float = BUDGET,
     server: str = SERVER,
     as_json: bool = AS_JSON,
 ) -> None:
@@ -122,8 +130,8 @@ def eval_translate_cmd(
     _translate(nl, aps, model, shots, examples_by, examples, seed, intervals, max_bound,
                any_bound, samples=samples, repair=repair, repair_by=repair_by, doubt=doubt,
                temperature=temperature, grammar_in_prompt=grammar_in_prompt,
-               constrained=not no_constraint, alternatives=alternatives, server=server,
-               as_json=as_json)
+               constrained=not no_constraint, alternatives=alternatives, budget_s=budget,
+               server=server, as_json=as_json)
 
 
 def _translate(nl: str, aps: str, model: str, shots: int | None, examples_by: str,
@@ -167,6 +175,7 @@ def translate_file_cmd(
     repair_by: str = REPAIR_BY_OPTION,
     doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,
+    budget: float = BUDGET,
     spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
                                        help="Seconds per Spot check against a reference."),
     progress: bool = typer.Option(True, "--progress/--no-progress",
@@ -205,7 +214,8 @@ def translate_file_cmd(
                                   bounds_from_request=not any_bound)
         todo = read_requests(requests, config)
         how = AnswerConfig.of(repair=repair, repair_by=repair_by, doubt=doubt,
-                              temperature=temperature, seed=seed, alternatives=alternatives)
+                              temperature=temperature, seed=seed, alternatives=alternatives,
+                              budget_s=budget)
         if out.is_dir():
             raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
         if out.exists() and out.stat().st_size and not resume:

@@ -30,6 +30,7 @@ from ara.errors import ConfigError
 from ara.eval.backends.base import Sampling
 from ara.eval.checks import gaps, mends
 from ara.eval.confidence import DOUBT, result_score
+from ara.eval.deadline import UNBOUNDED, Deadline
 from ara.eval.prompt import Shot
 from ara.eval.request import Request
 from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
@@ -131,15 +132,15 @@ class Vote:
         return len(self.groups[0]) / len(self.answers)
 
 
-def readings(vote: Vote, timeout_s: float = 10.0,
-             limit: int | None = None) -> list[tuple[str, float]]:
+def readings(vote: Vote, timeout_s: float = 10.0, limit: int | None = None,
+             deadline: Deadline = UNBOUNDED) -> list[tuple[str, float]]:
     """The distinct meanings among a vote's scored answers, best-scored first: each as
     the text the model scored highest among those of that meaning, with that
     log-probability. The winner comes first where it was scored; answers equivalent
     by Spot are one reading (a check Spot cannot decide in ``timeout_s`` keeps both).
     With a ``limit``, the first ``limit`` readings only, which spares the Spot checks
-    of the rest (seconds each on long formulas with large bounds).
-    """
+    of the rest (seconds each on long formulas with large bounds); once ``deadline``
+    is spent, those found by then."""
     kept: list[tuple[str, float]] = []
     for group in vote.groups:
         if limit is not None and len(kept) >= limit:
@@ -148,7 +149,9 @@ def readings(vote: Vote, timeout_s: float = 10.0,
         if score is None:
             continue
         stl = vote.results[group[0]].stl
-        if not any(_same(stl, other, timeout_s) for other, _ in kept):
+        if kept and deadline.spent():  # every further reading needs Spot checks
+            break
+        if not any(_same(stl, other, timeout_s, deadline) for other, _ in kept):
             kept.append((stl, score))
     return kept
 
@@ -156,7 +159,8 @@ def readings(vote: Vote, timeout_s: float = 10.0,
 def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
                          shots: Sequence[Shot] = (), samples: int = 5,
                          temperature: float = 0.7, seed: int = 0,
-                         timeout_s: float = 10.0, grammar_in_prompt: bool = False) -> Vote:
+                         timeout_s: float = 10.0, grammar_in_prompt: bool = False,
+                         deadline: Deadline = UNBOUNDED) -> Vote:
     """Translate ``nl`` ``samples`` times under the grammar and keep the majority meaning.
 
     Args:
@@ -167,27 +171,30 @@ def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
         seed: Answer ``i`` is drawn with seed ``seed + i``.
         timeout_s: Spot's limit per comparison; an undecided pair counts as different.
         grammar_in_prompt: Show the grammar in every prompt (variant P).
+        deadline: Once spent, no more answers are drawn or checked (greedy is made).
     """
     if samples < 1:
         raise ConfigError(f"samples must be >= 1, got {samples}")
     start = time.perf_counter()
     results = [translator.translate(nl, aps, shots, grammar_in_prompt)]
     results += _draw(translator, nl, aps, shots, samples - 1, temperature, seed,
-                     grammar_in_prompt)
-    groups = _group([r.stl for r in results], timeout_s)
+                     grammar_in_prompt, deadline)
+    groups = _group([r.stl for r in results], timeout_s, deadline)
     ranked = sorted(groups, key=lambda g: (-len(g), g[0]))
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
 def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
                        shots: Sequence[Shot] = (), repair: RepairConfig = RepairConfig(),
-                       timeout_s: float = 10.0, grammar_in_prompt: bool = False) -> Vote:
+                       timeout_s: float = 10.0, grammar_in_prompt: bool = False,
+                       deadline: Deadline = UNBOUNDED) -> Vote:
     """Translate ``nl`` greedily; if the answer leaves out part of the request, look for
     one that leaves out less, and if the model doubts it, for one it scores higher.
 
     Args:
-        translator, nl, aps, shots, timeout_s, grammar_in_prompt: As
-            :func:`translate_consistent`.
+        translator, nl, aps, shots, timeout_s, grammar_in_prompt, deadline: As
+            :func:`translate_consistent`; a spent deadline also stops mending and
+            scoring, and the greedy answer stays unless a scored one beats it.
         repair: How many answers to draw (``samples``), and how (``by``):
             ``samples+edits``: draw ``samples`` answers under the grammar, add the
             formulas one edit from the greedy answer that write what it left out
@@ -226,49 +233,54 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     if not gap:
         return _unless_doubted(translator, request, greedy, shots, samples, temperature, seed,
                                grammar_in_prompt, doubt if by == "samples+edits" else 0.0,
-                               start)
+                               start, deadline)
     if by != "samples" and translator.can_score:
         drawn = (_draw(translator, nl, aps, shots, samples, temperature, seed,
-                       grammar_in_prompt) if by == "samples+edits" else [])
-        mended = literal_mends(translator, request, greedy.stl, bounds)
+                       grammar_in_prompt, deadline) if by == "samples+edits" else [])
+        mended = [] if deadline.spent() else literal_mends(translator, request, greedy.stl, bounds)
         if drawn or mended:
             results = [greedy, *drawn, *(replace(greedy, raw=ANSWER_PREFIX + text, stl=text)
                                          for text in mended)]
             return _ranked_by_score(translator, request, results, shots, grammar_in_prompt,
-                                    greedy_stays=True, start=start)
+                                    greedy_stays=True, start=start, deadline=deadline)
     results = [greedy, *_draw(translator, nl, aps, shots, samples, temperature, seed,
-                              grammar_in_prompt)]
+                              grammar_in_prompt, deadline)]
     ranked = rank_repairs([r.stl for r in results],
-                          [_missing(request, r.stl, bounds) for r in results], timeout_s)
+                          [_missing(request, r.stl, bounds) for r in results], timeout_s,
+                          deadline)
     return Vote(tuple(results), tuple(ranked), (time.perf_counter() - start) * 1e3)
 
 
 def _unless_doubted(translator: Translator, request: Request, greedy: TranslationResult,
                     shots: Sequence[Shot], samples: int, temperature: float, seed: int,
-                    grammar_in_prompt: bool, doubt: float, start: float) -> Vote:
+                    grammar_in_prompt: bool, doubt: float, start: float,
+                    deadline: Deadline) -> Vote:
     """The complete greedy answer, with its score where the backend scores; if the model
     gives it a probability below ``doubt``, the best-scored of it and ``samples`` drawn
     answers that leave nothing out."""
     if not doubt or not translator.can_score:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
     score = result_score(translator, greedy, shots, grammar_in_prompt)  # decoding's, if any
-    if math.exp(score) >= doubt:
+    if math.exp(score) >= doubt or deadline.spent():
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3, (score,))
     results = [greedy, *_draw(translator, request.nl, request.aps, shots, samples,
-                              temperature, seed, grammar_in_prompt)]
+                              temperature, seed, grammar_in_prompt, deadline)]
     return _ranked_by_score(translator, request, results, shots, grammar_in_prompt,
-                            greedy_stays=False, start=start)
+                            greedy_stays=False, start=start, deadline=deadline)
 
 
 def _ranked_by_score(translator: Translator, request: Request,
                      results: Sequence[TranslationResult], shots: Sequence[Shot],
-                     grammar_in_prompt: bool, greedy_stays: bool, start: float) -> Vote:
+                     grammar_in_prompt: bool, greedy_stays: bool, start: float,
+                     deadline: Deadline) -> Vote:
     """A vote over ``results`` (greedy first) by the model's score of those that leave
-    out least (:func:`score_complete`, :func:`rank_scored`), grouped by text."""
+    out least (:func:`score_complete`, :func:`rank_scored`), grouped by text; none
+    scored once ``deadline`` is spent (the greedy answer first)."""
     answers = [r.stl for r in results]
     missing = [_missing(request, a, translator.config.intervals) for a in answers]
-    scores = score_complete(translator, request.nl, request.aps, answers, missing, shots,
-                            grammar_in_prompt)
+    scores = ([None] * len(answers) if deadline.spent() else
+              score_complete(translator, request.nl, request.aps, answers, missing, shots,
+                             grammar_in_prompt))
     order = rank_scored(missing, scores, greedy_stays)
     return Vote(tuple(results), _same_text(results, order),
                 (time.perf_counter() - start) * 1e3, tuple(scores))
@@ -309,21 +321,22 @@ def _same_text(results: Sequence[TranslationResult],
 
 
 def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
-                 timeout_s: float = 10.0) -> list[tuple[int, ...]]:
+                 timeout_s: float = 10.0,
+                 deadline: Deadline = UNBOUNDED) -> list[tuple[int, ...]]:
     """Groups of ``answers`` (greedy first), the winner first.
 
     ``missing[i]`` is how much of the request answer ``i`` leaves out. If no answer
     leaves out less than the greedy one, the greedy one's group wins; otherwise the
     largest group of the answers that leave out least (answers that leave out more
-    stand alone, after them).
+    stand alone, after them). Answers a spent ``deadline`` leaves unchecked stand alone.
     """
     least = min(missing)
     if least == missing[0]:
-        ranked = _group(answers, timeout_s)
+        ranked = _group(answers, timeout_s, deadline)
         ranked.sort(key=lambda g: (g[0] != 0, -len(g), g[0]))
     else:
         best = [a if m == least else None for a, m in zip(answers, missing, strict=True)]
-        ranked = _group(best, timeout_s)
+        ranked = _group(best, timeout_s, deadline)
         ranked.sort(key=lambda g: (missing[g[0]] != least, -len(g), g[0]))
     return ranked
 
@@ -342,10 +355,10 @@ def literal_mends(translator: Translator, request: Request, stl: str,
 
 def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],
           n: int, temperature: float, seed: int,
-          grammar_in_prompt: bool) -> list[TranslationResult]:
+          grammar_in_prompt: bool, deadline: Deadline) -> list[TranslationResult]:
     return [translator.translate(nl, aps, shots, grammar_in_prompt,
                                  sampling=Sampling(temperature=temperature, seed=seed + i))
-            for i in range(1, n + 1)]
+            for i in range(1, n + 1) if not deadline.spent()]
 
 
 def _missing(request: Request, stl: str | None, bounds: bool = True) -> float:
@@ -354,7 +367,8 @@ def _missing(request: Request, stl: str | None, bounds: bool = True) -> float:
     return float("inf") if stl is None else gaps(request, parse(stl)).count(timed=bounds)
 
 
-def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, ...]]:
+def _group(answers: Sequence[str | None], timeout_s: float,
+           deadline: Deadline = UNBOUNDED) -> list[tuple[int, ...]]:
     """Indices of equivalent answers together; unparsed answers each stand alone."""
     groups: list[list[int]] = []
     for i, text in enumerate(answers):
@@ -362,7 +376,7 @@ def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, .
         if text is not None:
             for g in groups:
                 first = answers[g[0]]
-                if first is not None and _same(text, first, timeout_s):
+                if first is not None and _same(text, first, timeout_s, deadline):
                     home = g
                     break
         if home is None:
@@ -372,10 +386,14 @@ def _group(answers: Sequence[str | None], timeout_s: float) -> list[tuple[int, .
     return [tuple(g) for g in groups]
 
 
-def _same(a: str, b: str, timeout_s: float) -> bool:
+def _same(a: str, b: str, timeout_s: float, deadline: Deadline = UNBOUNDED) -> bool:
+    """Whether Spot finds ``a`` and ``b`` the same within ``timeout_s`` and ``deadline``."""
     if a == b:  # canonical texts: equal text, equal tree
         return True
+    if deadline.spent():
+        return False
     try:
-        return equivalent(parse(a), parse(b), timeout_s=timeout_s)
+        return equivalent(parse(a), parse(b), timeout_s=deadline.within(timeout_s))
     except SpotTimeoutError:
+        deadline.spent()  # the budget, not the check's own limit, may have stopped it
         return False

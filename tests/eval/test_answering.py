@@ -3,17 +3,18 @@
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.answering import Answer, AnswerConfig, notes
+from ara.eval.answering import Answer, AnswerConfig, answer, notes
 from ara.eval.checks import gaps
 from ara.eval.consistency import RepairConfig, Vote
 from ara.eval.request import Request
-from ara.eval.translator import TranslationResult
+from ara.eval.translator import TranslationResult, Translator
 from ara.grammars import parse
 
 #: The keys of `ara translate --json`, in the order translate-file writes them
 #: (Answer.to_json's docstring, docs/evaluation.md).
-DOCUMENTED_KEYS = ["stl", "valid", "raw", "ms", "error", "model", "constrained", "shots",
-                   "grammar", "samples", "confidence", "alternatives", "left_out", "unasked"]
+DOCUMENTED_KEYS = ["stl", "valid", "raw", "ms", "budget", "error", "model", "constrained",
+                   "shots", "grammar", "samples", "confidence", "alternatives", "left_out",
+                   "unasked"]
 
 
 def _result(stl: str, nl: str = "( prop_1 ) or ( prop_2 ) at some point") -> TranslationResult:
@@ -43,6 +44,10 @@ def test_the_json_of_an_answer_has_the_documented_keys_in_order():
     assert [k for k in DOCUMENTED_KEYS if k not in greedy] == ["samples", "left_out",
                                                               "unasked"]
     assert greedy["ms"] == 12.3 and greedy["confidence"] is None
+    assert greedy["budget"] == {"s": None, "ran_out": False}
+    waited = Answer(vote.result, "m", vote, waited_ms=98.76, budget_s=5.0, ran_out=True)
+    assert waited.to_json()["ms"] == 98.8  # what the user waited, not the vote's time
+    assert waited.to_json()["budget"] == {"s": 5.0, "ran_out": True}
 
 
 def test_notes_read_the_typed_answer():
@@ -65,6 +70,8 @@ def test_notes_read_the_typed_answer():
         ({"temperature": 0}, "temperature must be > 0"),  # a division by zero later
         ({"samples": 3, "repair": 2}, "two ways to spend extra answers; pass one"),
         ({"repair": 2, "constrained": False}, "--repair decodes under the grammar"),
+        ({"budget_s": -1}, r"the budget is seconds per answer, >= 0 \(0: unbounded\)"),
+        ({"budget_s": float("inf")}, "got inf"),  # unbounded is 0, not a number
     ],
 )
 def test_bad_answer_options_are_refused_with_the_fix(options, message):
@@ -79,3 +86,31 @@ def test_repair_defaults_to_on_unless_answers_are_voted_or_unconstrained():
     assert AnswerConfig(samples=3).repairs == 0
     assert AnswerConfig(constrained=False).repairs == 0
     assert AnswerConfig(repair=RepairConfig(0)).repairs == 0
+
+
+#: A sentence the shipped model doubts its complete answer to: repair draws for it.
+DOUBTED = ("( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2"))
+
+
+def test_an_answer_out_of_time_is_the_greedy_one_and_says_so(finetuned):
+    """Tests that a budget spent before repair can act gives the greedy answer, valid
+    and checked for gaps, says it ran out, and counts in ms the whole wait."""
+    t = Translator(finetuned)
+    greedy = t.translate(*DOUBTED)
+    hurried = answer(t, *DOUBTED, config=AnswerConfig.of(budget_s=0.001))
+    assert hurried.stl == greedy.stl and hurried.result.valid
+    assert hurried.vote.answers == (greedy.stl,) and hurried.gaps is not None
+    assert hurried.ran_out and hurried.to_json()["budget"] == {"s": 0.001, "ran_out": True}
+    assert hurried.ms >= hurried.result.ms
+    assert "ran out" in " ".join(notes(hurried, DOUBTED[0]))
+
+
+def test_an_unbounded_answer_never_runs_out(finetuned):
+    """Tests that without a budget (0) repair draws every answer it would, and the
+    answer never says it ran out."""
+    unbounded = answer(Translator(finetuned), *DOUBTED, config=AnswerConfig.of(repair=4,
+                                                                             budget_s=0))
+    assert len(unbounded.vote.answers) == 5  # the greedy one and the four drawn
+    assert not unbounded.ran_out
+    assert unbounded.to_json()["budget"] == {"s": None, "ran_out": False}
+    assert not any("ran out" in note for note in notes(unbounded, DOUBTED[0]))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import pytest
 
@@ -14,12 +15,14 @@ from ara.eval.consistency import (
     Vote,
     _group,
     _missing,
+    _same,
     literal_mends,
     rank_repairs,
     readings,
     translate_consistent,
     translate_repaired,
 )
+from ara.eval.deadline import UNBOUNDED, Deadline
 from ara.eval.request import Request
 from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
@@ -52,6 +55,32 @@ def test_readings_are_the_distinct_meanings_best_scored_first():
     assert readings(vote, timeout_s=10, limit=1) == [("F(a) | F(b)", -0.5)]
     greedy_only = Vote((_answer("G(a)"),), ((0,),), 0.0)  # nothing scored
     assert readings(greedy_only) == []
+
+
+def spent_deadline() -> Deadline:
+    """A budget of one second, started two seconds ago."""
+    return Deadline(1.0, start=time.perf_counter() - 2.0)
+
+
+def test_spot_checks_stop_when_the_budget_is_spent():
+    """Tests that a spent budget answers 'not the same' without asking Spot (equal texts
+    still are), so that grouping leaves each meaning alone, and says it ran out."""
+    deadline = spent_deadline()
+    assert _same("G(a)", "G(a)", 10.0, deadline) and not deadline.ran_out
+    assert not _same("F(a) | F(b)", "F(a | b)", 10.0, deadline) and deadline.ran_out
+    answers = ["F(a) | F(b)", "F(a | b)", "F(a) | F(b)"]
+    assert _group(answers, 10.0, spent_deadline()) == [(0, 2), (1,)]
+    assert _group(answers, 10.0, UNBOUNDED) == [(0, 1, 2)]
+
+
+def test_readings_stop_at_the_winner_when_the_budget_is_spent():
+    """Tests that a spent budget lists the winner's reading (no Spot check needed) and
+    no other."""
+    vote = Vote((_answer("F(a) | F(b)"), _answer("G(a)")), ((0,), (1,)), 0.0, (-0.5, -1.2))
+    deadline = spent_deadline()
+    assert readings(vote, 10.0, deadline=deadline) == [("F(a) | F(b)", -0.5)]
+    assert deadline.ran_out
+    assert len(readings(vote, 10.0)) == 2
 
 
 def test_sampling_settings_are_checked():
