@@ -240,7 +240,8 @@ def test_translate_notes_an_answer_the_model_doubts():
     """Tests the note and the JSON field: a sentence of words that say nothing temporal
     gets an answer the model gives a low probability, read back in English; a plain
     instruction gets neither note nor doubt."""
-    args = ["( prop_1 ) purple elephant ( prop_2 )", "--aps", "prop_1,prop_2"]
+    # unbounded (--budget 0): what repair weighs, however slow the machine
+    args = ["( prop_1 ) purple elephant ( prop_2 )", "--aps", "prop_1,prop_2", "--budget", "0"]
     out = ara("translate", *args)
     assert out.returncode == 0
     assert "note: the model gives this answer a probability of" in out.stderr
@@ -260,7 +261,7 @@ def test_a_doubted_answer_comes_with_the_other_readings_the_model_weighed():
     from ara.grammars import parse
     from ara.grammars.spot_bridge import equivalent
 
-    args = ["( prop_1 ) or ( prop_2 ) at some point", "--aps", "prop_1,prop_2"]
+    args = ["( prop_1 ) or ( prop_2 ) at some point", "--aps", "prop_1,prop_2", "--budget", "0"]
     data = json.loads(ara("translate", *args, "--json").stdout)
     assert data["confidence"] < 0.5 and 1 <= len(data["alternatives"]) <= 2
     for other in data["alternatives"]:
