@@ -30,6 +30,23 @@ def _sha256(path: str, size: int, mtime_ns: int) -> str:
     return digest.hexdigest()
 
 
+def differing(saved: dict, now: dict) -> dict[str, tuple]:
+    """The settings whose values differ between two nested dicts, by dotted name in
+    sorted order (``{"optim": {"lr": 1}}`` holds ``optim.lr``), each with its value in
+    ``saved`` and in ``now`` (``None`` where one lacks it): what a resumed run checks
+    against the record of the run it goes on with."""
+    before, after = _flat(saved), _flat(now)
+    return {k: (before.get(k), after.get(k)) for k in sorted(before.keys() | after.keys())
+            if before.get(k) != after.get(k)}
+
+
+def _flat(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        out.update(_flat(v, f"{prefix}{k}.") if isinstance(v, dict) else {f"{prefix}{k}": v})
+    return out
+
+
 def git_commit() -> str | None:
     """The commit of the checkout this code runs from, or ``None`` outside git."""
     try:

@@ -28,6 +28,7 @@ from ara.eval.harness import judge
 from ara.eval.prompt import Shot
 from ara.eval.translator import Translator, TranslatorConfig, check_request
 from ara.grammars import atoms, parse, to_text
+from ara.provenance import differing
 
 #: Bad lines named in one error; the rest are counted.
 MAX_REPORTED = 10
@@ -164,25 +165,17 @@ def same_settings(out: Path, settings: dict) -> None:
         ConfigError: If ``out`` was made with other settings, naming the first that differs.
     """
     path = settings_path(out)
-    now = _flat(json.loads(json.dumps(settings)))  # tuples compare as the lists saved
     if not out.exists() or not out.stat().st_size:
         path.write_text(json.dumps(settings, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     elif path.exists():  # outputs from before settings were kept resume as they did
-        before = _flat(json.loads(path.read_text(encoding="utf-8")))
-        for name in sorted(before.keys() | now.keys()):
-            if before.get(name) != now.get(name):
-                raise ConfigError(
-                    f"{out} was made with {name} = {json.dumps(before.get(name))}, this run has "
-                    f"{json.dumps(now.get(name))} ({path}): pass the options it was made with "
-                    "to resume it, or choose another --out")
-
-
-def _flat(value: object, prefix: str = "") -> dict:
-    """``{"a": {"b": 1}}`` -> ``{"a.b": 1}``."""
-    if not isinstance(value, dict):
-        return {prefix: value}
-    return {name: leaf for key, sub in value.items()
-            for name, leaf in _flat(sub, f"{prefix}.{key}" if prefix else key).items()}
+        changed = differing(json.loads(path.read_text(encoding="utf-8")),
+                            json.loads(json.dumps(settings)))  # tuples as the lists saved
+        if changed:
+            name, (before, after) = next(iter(changed.items()))
+            raise ConfigError(
+                f"{out} was made with {name} = {json.dumps(before)}, this run has "
+                f"{json.dumps(after)} ({path}): pass the options it was made with "
+                "to resume it, or choose another --out")
 
 
 def translate_requests(translator: Translator, requests: Iterable[FileRequest], out: Path,

@@ -24,6 +24,7 @@ from tqdm import tqdm
 
 from ara import __version__
 from ara.errors import ConfigError
+from ara.provenance import differing
 from ara.training.config import TrainConfig
 from ara.training.dataset import (
     answer_loss_sum,
@@ -361,21 +362,13 @@ def _adapter_identity(folder: str | Path | None) -> dict | None:
     return {"path": str(folder), "sha256": digest}
 
 
-def _flat(d: dict, prefix: str = "") -> dict:
-    out = {}
-    for k, v in d.items():
-        out.update(_flat(v, f"{prefix}{k}.") if isinstance(v, dict) else {f"{prefix}{k}": v})
-    return out
-
-
 def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
     """A resumed run continues the same training: the same data, schedule and model."""
-    saved = _flat(json.loads(run_json.read_text())["config"])
-    now = _flat(config.to_dict())
-    changed = sorted(k for k in saved.keys() | now.keys()
-                     if saved.get(k) != now.get(k) and k not in _RESUMABLE_KEYS)
+    changed = {k: values for k, values in differing(
+        json.loads(run_json.read_text())["config"], config.to_dict()).items()
+        if k not in _RESUMABLE_KEYS}
     if changed:
-        detail = ", ".join(f"{k}: {saved.get(k)!r} -> {now.get(k)!r}" for k in changed)
+        detail = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
         raise ConfigError(
             f"--resume: the config differs from the one {run_json.parent} was started with "
             f"({detail}); resume with the same config (only max_steps, checkpoint_every, "
