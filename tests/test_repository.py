@@ -9,12 +9,6 @@ import pytest
 ROOT = Path(__file__).parents[1]
 MB = 1_000_000
 
-#: The last LoRA checkpoints of the run chain that led to the shipped adapter, still in
-#: the tree: one change may carry at most 256 MiB of diffs, and deleting them with the
-#: rest of the lab record would pass that. The next change deletes them and this list.
-LEAVING = "docs/results/training/"
-
-
 def tracked() -> list[Path]:
     try:
         names = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, check=True,
@@ -26,7 +20,7 @@ def tracked() -> list[Path]:
 
 def kept(path: Path) -> bool:
     name = path.relative_to(ROOT).as_posix()
-    return not name.startswith(("eval/models/", LEAVING))
+    return not name.startswith("eval/models/")
 
 
 def test_no_tracked_file_outside_the_shipped_models_is_over_1_mb():
