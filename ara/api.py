@@ -9,12 +9,12 @@
     >>> ara.equivalent("G(!(a | b))", "G(!a) & G(!b)")
     True
 
-:func:`translate` returns an :class:`~ara.eval.answering.Answer` (the formula, its
+:func:`translate` returns an :class:`~ara.eval.translate.answering.Answer` (the formula, its
 confidence, the other readings where the model doubts, what it leaves out of the
 request; ``answer.to_json()`` is what ``ara translate --json`` prints) and keeps the
 model loaded between calls. For finer control use the parts
-it is made of: :class:`ara.eval.translator.Translator`,
-:func:`ara.eval.answering.answer`, :mod:`ara.grammars`.
+it is made of: :class:`ara.eval.translate.translator.Translator`,
+:func:`ara.eval.translate.answering.answer`, :mod:`ara.grammars`.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 from ara.grammars import parse
 
 if TYPE_CHECKING:  # the model's modules load on first use
-    from ara.eval.answering import Answer
+    from ara.eval.translate.answering import Answer
 
 
 def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
@@ -45,7 +45,7 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
             or ``similar`` to ``nl``) and from which file of pairs (``None``: the
             training mixture), as ``--examples-by`` and ``--examples``.
         **how: ``ara translate``'s other options, as :meth:`AnswerConfig.of
-            <ara.eval.answering.AnswerConfig.of>` names them (``repair``, ``repair_by``,
+            <ara.eval.translate.answering.AnswerConfig.of>` names them (``repair``, ``repair_by``,
             ``samples``, ``doubt``, ``alternatives``, ``budget_s``: seconds for the whole
             answer, ``--budget``, ...).
 
@@ -58,8 +58,8 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
             instruction, a proposition the sentence never mentions, a bound above
             ``max_bound``) or a bad option.
     """
-    from ara.eval.answering import AnswerConfig, answer, worked_examples
-    from ara.eval.translator import TranslatorConfig, check_request
+    from ara.eval.translate.answering import AnswerConfig, answer, worked_examples
+    from ara.eval.translate.translator import TranslatorConfig, check_request
 
     aps = tuple(aps)
     config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
@@ -73,13 +73,13 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
 
 @lru_cache(maxsize=4)
 def translator(model: str = "finetuned", config=None, server: str = "openai"):
-    """The :class:`~ara.eval.translator.Translator` for ``model`` and ``config`` (a
-    :class:`~ara.eval.translator.TranslatorConfig`), loaded once and kept: loading the
+    """The :class:`~ara.eval.translate.translator.Translator` for ``model`` and ``config`` (a
+    :class:`~ara.eval.translate.translator.TranslatorConfig`), loaded once and kept: loading the
     embedded model takes seconds, a translation a fraction of one. Translators of one
     model with other configs share its backend
-    (:func:`~ara.eval.models.shared_backend`)."""
-    from ara.eval.models import shared_backend
-    from ara.eval.translator import Translator
+    (:func:`~ara.eval.translate.models.shared_backend`)."""
+    from ara.eval.translate.models import shared_backend
+    from ara.eval.translate.translator import Translator
 
     return Translator(shared_backend(model, server=server), config)
 

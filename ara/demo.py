@@ -30,7 +30,7 @@ def demo_cmd(
     import lark
 
     from ara.data import SPLITS, prepare
-    from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.eval.translate.llama_check import LlamaGrammarChecker
     from ara.grammars import Syntax, build_grammar, parse
     from ara.grammars.spot_bridge import equivalent, implies
 
@@ -64,7 +64,7 @@ def demo_cmd(
     typer.echo(f"  {noisy[0]:<32} vs {noisy[1]:<32} equivalent="
                f"{equivalent(parse(noisy[0]), parse(noisy[1]))}  (NL2TL's two spellings)")
     if shots is None:
-        from ara.eval.models import default_shots
+        from ara.eval.translate.models import default_shots
 
         shots = default_shots(model)
     translator = _translate_some(model, n, seed, shots)
@@ -83,10 +83,10 @@ def _help_round(translator) -> None:
 
 def _translate_some(model: str, n: int, seed: int, k: int):
     from ara.data import prepare
-    from ara.eval.harness import judge
-    from ara.eval.models import shared_backend
-    from ara.eval.prompt import sample_shots
-    from ara.eval.translator import Translator
+    from ara.eval.translate.models import shared_backend
+    from ara.eval.translate.prompt import sample_shots
+    from ara.eval.translate.translator import Translator
+    from ara.grammars.spot_bridge import judge
 
     rng = random.Random(seed)
     pool = prepare("compositional", 0).records("train", "grounded")

@@ -6,7 +6,7 @@ side by side in one run on the same held-out sentences.
 
 Each sentence (``--limit`` of the split's test side, drawn with seed 0; the default is
 NL2TL's timed dev set, where long bounds over many propositions make the slowest
-answers) is answered as ``ara translate`` answers it (:func:`~ara.eval.answering.answer`:
+answers) is answered as ``ara translate`` answers it (:func:`~ara.eval.translate.answering.answer`:
 repair, confidence, the other readings, the gap checks), once within ``--budget``
 seconds and once unbounded (``--budget 0``), the budgeted one first so that the Spot
 results and prompts it leaves cached can only speed up the unbounded one. The time is
@@ -31,9 +31,9 @@ from tqdm import tqdm
 
 from ara import __version__
 from ara.data import load_or_prepare
-from ara.eval.answering import BUDGET_S, AnswerConfig, answer, worked_examples
-from ara.eval.models import make_backend
-from ara.eval.translator import Translator
+from ara.eval.translate.answering import BUDGET_S, AnswerConfig, answer, worked_examples
+from ara.eval.translate.models import make_backend
+from ara.eval.translate.translator import Translator
 from ara.provenance import git_commit
 
 

@@ -15,18 +15,18 @@ model that gave them: the bench refuses folders run with another), judged right 
 wrong as the run judged it. Prints, per folder, the area under the ROC curve (the chance
 that a right answer scores above a wrong one), then, for thresholds on the probability,
 how many answers fall below, how many of those are wrong, and how right the rest are,
-on the ``--dev`` folders (where :data:`~ara.eval.confidence.DOUBT` was chosen) and on
+on the ``--dev`` folders (where :data:`~ara.eval.translate.confidence.DOUBT` was chosen) and on
 the others apart. For each wrong answer it also scores the reference: how often the
 model would rank the right answer first if it were offered. ``--resample K`` asks
 whether flagged answers can be fixed without a reference: each answer below DOUBT is
 translated again with self-consistency (greedy + K samples, the largest group by
-meaning wins; :func:`~ara.eval.consistency.translate_consistent`) and judged; Spot
+meaning wins; :func:`~ara.eval.translate.repair.translate_consistent`) and judged; Spot
 takes minutes to group the samples of a long compositional formula, hence the second
 command's narrower glob (the hand-written suites and the timed set). ``--readings K``
 asks what a user who is shown the other readings gains: each answer below DOUBT is
 translated again as ``ara translate`` does by default (repair by samples and edits,
-:func:`~ara.eval.consistency.translate_repaired`), and the winner and up to K other
-readings it weighed (:func:`~ara.eval.consistency.readings`, what ``ara translate
+:func:`~ara.eval.translate.repair.translate_repaired`), and the winner and up to K other
+readings it weighed (:func:`~ara.eval.translate.repair.readings`, what ``ara translate
 --alternatives`` lists) are judged: how often the right one is first, among the first
 two, and so on.
 """
@@ -45,11 +45,11 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ara.eval.confidence import DOUBT, answer_probability
-from ara.eval.consistency import readings, translate_consistent, translate_repaired
-from ara.eval.harness import judge
-from ara.eval.models import make_backend
-from ara.eval.translator import Translator
+from ara.eval.translate.confidence import DOUBT, answer_probability
+from ara.eval.translate.models import make_backend
+from ara.eval.translate.repair import readings, translate_consistent, translate_repaired
+from ara.eval.translate.translator import Translator
+from ara.grammars.spot_bridge import judge
 
 THRESHOLDS = (0.8, 0.6, DOUBT, 0.3, 0.1)
 

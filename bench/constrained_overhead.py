@@ -20,8 +20,8 @@ import random
 import statistics
 
 from ara.data import load_split
-from ara.eval.prompt import sample_shots
-from ara.eval.translator import Translator
+from ara.eval.translate.prompt import sample_shots
+from ara.eval.translate.translator import Translator
 
 
 def measure(translator: Translator, records, shots, constrained: bool) -> dict:
@@ -48,8 +48,8 @@ def main() -> None:
                     help="also llama.cpp's built-in grammar sampler (slow)")
     args = ap.parse_args()
 
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-    from ara.eval.llama_check import default_model_path
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.llama_check import default_model_path
 
     split = load_split("paper")
     rng = random.Random(0)
@@ -69,7 +69,7 @@ def main() -> None:
         print(row("llama.cpp / built-in grammar", free,
                   measure(builtin, records, shots, True)), flush=True)
     if args.hf:
-        from ara.eval.backends.hf_backend import HFBackend
+        from ara.eval.translate.backends.hf_backend import HFBackend
         from ara.training.hf_model import prepare_base_model
 
         folder = str(prepare_base_model())

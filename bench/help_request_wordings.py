@@ -18,17 +18,12 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ara.coordination.protocol import (
-    REQUEST_WORDINGS,
-    help_props,
-    request_shots,
-    request_text,
-    template_help_spec,
-)
+from ara.coordination.protocol import REQUEST_WORDINGS, request_shots, request_text
 from ara.coordination.world import GridWorld
-from ara.eval.consistency import translate_repaired
-from ara.eval.models import make_backend
-from ara.eval.translator import Translator
+from ara.data.help_requests import help_props, template_help_spec
+from ara.eval.translate.models import make_backend
+from ara.eval.translate.repair import translate_repaired
+from ara.eval.translate.translator import Translator
 from ara.grammars import parse
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 

@@ -9,13 +9,13 @@ again, and judges with Spot, side by side:
 
 - ``greedy``: the greedy answer alone;
 - ``samples``: K samples under the request's grammar, majority of the answers that
-  leave out least (``--repair-by samples``; :func:`ara.eval.consistency.translate_repaired`);
+  leave out least (``--repair-by samples``; :func:`ara.eval.translate.repair.translate_repaired`);
 - ``forced``: one greedy answer under a grammar that must write what was left out
   (:func:`ara.grammars.require_literals`);
 - ``forced+samples``: both kinds of extra answer, ranked as the shipped repair ranks;
 - ``forced samples``: K samples under the forcing grammar, majority;
 - ``edits``: the formulas one edit from the greedy answer that write what it left out
-  (:func:`ara.eval.consistency.literal_mends`), the one the model scores highest
+  (:func:`ara.eval.translate.repair.literal_mends`), the one the model scores highest
   (``--repair-by edits``);
 - ``samples+edits``: the K samples and those edits, the highest-scoring of the answers
   that leave out least (``--repair-by samples+edits``, the default).
@@ -41,20 +41,20 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ara.data import load_or_prepare
-from ara.eval.backends.base import Sampling
-from ara.eval.checks import gaps
-from ara.eval.consistency import (
+from ara.eval.translate.backends.base import Sampling
+from ara.eval.translate.checks import gaps
+from ara.eval.translate.models import make_backend
+from ara.eval.translate.repair import (
     _missing,
     literal_mends,
     rank_repairs,
     rank_scored,
     score_complete,
 )
-from ara.eval.harness import judge
-from ara.eval.models import make_backend
-from ara.eval.request import Request
-from ara.eval.translator import Translator
+from ara.eval.translate.request import Request
+from ara.eval.translate.translator import Translator
 from ara.grammars import parse
+from ara.grammars.spot_bridge import judge
 
 STRATEGIES = ("greedy", "samples", "forced", "forced+samples", "forced samples", "edits",
               "samples+edits")

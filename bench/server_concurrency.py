@@ -25,12 +25,12 @@ import urllib.request
 from concurrent.futures import ThreadPoolExecutor
 
 from ara.data import load_or_prepare
-from ara.eval.backends.openai_http import OpenAIBackend
-from ara.eval.translator import Translator
+from ara.eval.translate.backends.openai_http import OpenAIBackend
+from ara.eval.translate.translator import Translator
 
 
 def start_loopback_server() -> tuple[str, subprocess.Popen]:
-    from ara.eval.llama_check import default_model_path
+    from ara.eval.translate.llama_check import default_model_path
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

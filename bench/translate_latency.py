@@ -15,7 +15,7 @@ with the default grammar, so a candidate is timed beside what ships, in the same
 by samples+edits (the default; it also draws for a complete answer the model doubts),
 by edits and by samples: its median is the greedy answer's, its mean carries the extra
 work for the few it acts on. The row "ara translate" is what the command does by
-default (:func:`~ara.eval.answering.answer`): repair, the model's probability of the
+default (:func:`~ara.eval.translate.answering.answer`): repair, the model's probability of the
 answer it gives (the confidence note; free where repair scored the answer already), and
 for a doubted answer the other readings it weighed (Spot checks between them).
 """
@@ -30,10 +30,10 @@ import statistics
 import time
 
 from ara.data import load_or_prepare
-from ara.eval.answering import answer
-from ara.eval.consistency import REPAIR_BY, RepairConfig, translate_repaired
-from ara.eval.models import make_backend
-from ara.eval.translator import Translator, TranslatorConfig
+from ara.eval.translate.answering import answer
+from ara.eval.translate.models import make_backend
+from ara.eval.translate.repair import REPAIR_BY, RepairConfig, translate_repaired
+from ara.eval.translate.translator import Translator, TranslatorConfig
 
 
 def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0],

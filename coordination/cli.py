@@ -17,8 +17,8 @@ def _translator(llm: str):
     """None for --llm none; else the eval translator over that model."""
     if llm == "none":
         return None
-    from ara.eval.models import shared_backend
-    from ara.eval.translator import Translator
+    from ara.eval.translate.models import shared_backend
+    from ara.eval.translate.translator import Translator
 
     return Translator(shared_backend(llm))
 

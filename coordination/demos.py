@@ -27,8 +27,9 @@ from ara.coordination.protocol import (
     run_round,
     template_help_spec,
 )
-from ara.coordination.specs import job_names, jobs_vocabulary, pick_ap, place_ap
+from ara.coordination.specs import job_names, jobs_vocabulary
 from ara.coordination.world import Cell, GridWorld
+from ara.data.help_requests import pick_ap, place_ap
 from ara.errors import ConfigError
 from ara.grammars import parse
 from ara.grammars.spot_bridge import equivalent
@@ -122,7 +123,7 @@ def _errand(world: GridWorld, errand: Errand, translator, echo) -> dict:
     if translator is None:
         stl, source = errand.reference, "reference"
     else:
-        from ara.eval.answering import answer, notes
+        from ara.eval.translate.answering import answer, notes
 
         # Answered and checked as `ara translate` does, so the demo shows what a user gets
         answered = answer(translator, errand.nl, aps)

@@ -22,7 +22,7 @@ adds the help job; nothing else changes) and ``b3`` (that forklift takes the hel
 job and the exact Oracle re-optimizes everything else).
 
 Each finished trial's rows are appended to ``trials.jsonl`` at once and made durable
-together (:class:`~ara.eval.run_store.RunStore`), so an interrupted run resumes where
+together (:class:`~ara.run_store.RunStore`), so an interrupted run resumes where
 it stopped; ``trials.csv``, ``summary.json`` and ``boxplot.png`` are
 written from it at the end (:mod:`ara.coordination.exp2_report`). The settings are
 :class:`~ara.coordination.exp2_config.Exp2Config`, the instances
@@ -60,10 +60,10 @@ from ara.coordination.protocol import (
     choose,
     make_offer,
     request_text,
-    template_help_spec,
 )
 from ara.coordination.trials import PAPER_WORLD, Trial, closest_robot, make_trial
-from ara.eval.translator import Translator
+from ara.data.help_requests import template_help_spec
+from ara.eval.translate.translator import Translator
 
 #: The run folder's row log: one JSON line per (trial, method).
 TRIALS = "trials.jsonl"
@@ -164,8 +164,8 @@ def run(config: Exp2Config, out: str | Path, n_jobs: int = 1, translator_factory
     """Run (or resume) the experiment into ``out``; returns the summary."""
     from tqdm import tqdm
 
-    from ara.eval.run_store import RunStore, read_samples
     from ara.provenance import git_commit
+    from ara.run_store import RunStore, read_samples
 
     out = Path(out)
     # The translator first: its model hash belongs to the run's identity, so a resumed

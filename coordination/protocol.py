@@ -22,20 +22,16 @@ from ara.coordination.events import UnsupportedSpec, Vocabulary
 from ara.coordination.milp import MILPSolver
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
-from ara.coordination.specs import (
-    carry_alone,
-    job_names,
-    jobs_spec,
-    jobs_vocabulary,
-    pick_ap,
-    place_ap,
-    pnp_spec,
-)
+from ara.coordination.specs import job_names, jobs_spec, jobs_vocabulary
 from ara.coordination.world import Cell, GridWorld, WorldError
+from ara.data.help_requests import (
+    carry_alone,
+    help_props,
+    template_help_spec,
+)
 from ara.errors import AraError
 from ara.grammars import And, Formula, parse
 from ara.grammars import to_text as stl_text
-from ara.grammars.ast import rename_atoms
 
 PLANNERS = ("dp", "milp")
 
@@ -206,16 +202,10 @@ class Helper:
     jobs: tuple[Job, ...]
 
 
-def help_props(site: Cell, drop: Cell) -> tuple[str, str]:
-    """A helper's propositions for the help job: named after their cells, since that
-    is what the request says."""
-    return (pick_ap(f"r{site[0]}c{site[1]}"), place_ap(f"r{drop[0]}c{drop[1]}"))
-
-
 def request_shots() -> tuple:
     """Two worked requests (other sites, the paper's wording) for the translator's
     prompt; each answer is the template's pick-before-place spec for its site."""
-    from ara.eval.prompt import Shot
+    from ara.eval.translate.prompt import Shot
 
     shots = []
     for site, drop in (((5, 2), (4, 2)), ((0, 6), (1, 6))):
@@ -223,17 +213,6 @@ def request_shots() -> tuple:
         shots.append(Shot(request_text(site, ("navigate",)), (pick, place),
                           stl_text(template_help_spec(site, drop, ()))))
     return tuple(shots)
-
-
-def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula:
-    """The help job's PNP spec, written from the request's fields (no LLM).
-
-    Its conjunctions nest two at a time, ``(phi1 & phi2) & phi3``, so the decoding
-    grammar (at most two arguments per ``&``) can write it."""
-    pick, place = help_props(site, drop)
-    spec = rename_atoms(pnp_spec("h", others), {pick_ap("h"): pick, place_ap("h"): place})
-    first, second, third = spec.args
-    return And((And((first, second)), third))
 
 
 @dataclass
@@ -256,7 +235,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
                help_formula: Formula | None = None) -> Offer:
     """A helper reads the request, writes its STL, plans, and bids.
 
-    With a ``translator`` (a :class:`~ara.eval.translator.Translator`) the help formula
+    With a ``translator`` (a :class:`~ara.eval.translate.translator.Translator`) the help formula
     is its translation, repaired as ``ara translate`` repairs it (logged in the offer,
     right or wrong, and planned as it says); with ``help_formula`` it is that formula
     (over :func:`help_props`); otherwise it is the template spec. The DP planner
@@ -289,7 +268,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     others = sorted(own_vocab.events)
     template = template_help_spec(site, drop, others)
     if translator is not None:
-        from ara.eval.consistency import translate_repaired
+        from ara.eval.translate.repair import translate_repaired
 
         shots = request_shots() if shots is None else shots
         # Repaired as `ara translate` repairs, so a helper reads a request as a user's

@@ -1,15 +1,9 @@
 """The specifications robots plan for, built as ASTs of :mod:`ara.grammars`.
 
-A pick-and-place job ``j`` is the paper's App. A.2 conjunction over its two action
-propositions ``pick_j`` and ``place_j``::
-
-    phi1 = (!place_j) U pick_j              # nothing is placed before it is picked
-    phi2 = G(pick_j -> (!others) U place_j)  # carrying j, touch nothing else first
-    phi3 = F place_j                        # and it is placed
-
-The global spec is ``G(!obstacle & actuation)``. Formulas are built here, never
-parsed from strings; a helper's translated help request joins them as one more
-conjunct.
+Each job is the paper's pick-and-place conjunction (:func:`ara.data.help_requests.pnp_spec`,
+where a help request's template spec is built too); the global spec is
+``G(!obstacle & actuation)``. Formulas are built here, never parsed from strings; a
+helper's translated help request joins them as one more conjunct.
 """
 
 from __future__ import annotations
@@ -19,34 +13,10 @@ from collections.abc import Sequence
 from ara.coordination.events import Vocabulary
 from ara.coordination.planner_dp import Job
 from ara.coordination.world import GridWorld
-from ara.grammars import Always, And, Atom, Eventually, Formula, Implies, Not, Or, Until
+from ara.data.help_requests import pick_ap, place_ap, pnp_spec
+from ara.grammars import Always, And, Atom, Formula, Not
 
 OBSTACLE, ACTUATION = "obstacle", "actuation"
-
-
-def pick_ap(name: str) -> str:
-    return f"pick_{name}"
-
-
-def place_ap(name: str) -> str:
-    return f"place_{name}"
-
-
-def pnp_spec(name: str, others: Sequence[str] = ()) -> Formula:
-    """phi1 & phi2 & phi3 for job ``name``; ``others`` are the other jobs' propositions."""
-    pick, place = Atom(pick_ap(name)), Atom(place_ap(name))
-    return And((Until(Not(place), pick), carry_alone(pick.name, place.name, others),
-                Eventually(place)))
-
-
-def carry_alone(pick: str, place: str, others: Sequence[str]) -> Formula:
-    """phi2: once ``pick`` happens, none of ``others`` before ``place`` (one pallet at a
-    time); ``G(pick -> F place)`` when there are no others."""
-    carry: Formula = Eventually(Atom(place))  # true U place
-    if others:
-        blocked = Atom(others[0]) if len(others) == 1 else Or(tuple(Atom(o) for o in others))
-        carry = Until(Not(blocked), Atom(place))
-    return Always(Implies(Atom(pick), carry))
 
 
 def global_spec() -> Formula:

@@ -1,8 +1,7 @@
-"""Natural language to STL: translators over local and remote models, and the paper's
-F/P/C ablation judged by Spot.
+"""Natural language to STL: the translator, and the paper's F/P/C ablation judged by Spot.
 
-* :mod:`ara.eval.translator`: prompt a backend under the request's own grammar.
-* :mod:`ara.eval.backends`: llama.cpp (the embedded GGUF), transformers, HTTP servers.
-* :mod:`ara.eval.harness`, :mod:`ara.eval.ablation`: resumable evaluation runs.
-* :mod:`ara.eval.models`: what ``--model`` names (the shipped adapters among them).
+* :mod:`ara.eval.translate`: the product, what ``ara translate`` runs.
+* :mod:`ara.eval.harness`, :mod:`ara.eval.ablation`: resumable evaluation runs over it.
+* :mod:`ara.eval.metrics`, :mod:`ara.eval.report`, :mod:`ara.eval.run_diff`: their
+  figures, tables and comparisons.
 """

@@ -9,7 +9,6 @@ from tqdm import tqdm
 
 from ara.data import load_or_prepare
 from ara.errors import ConfigError
-from ara.eval.backends.base import Backend
 from ara.eval.harness import (
     FILE_SPLIT,
     AblationConfig,
@@ -20,9 +19,10 @@ from ara.eval.harness import (
     translate_job,
 )
 from ara.eval.report import Results, write_report
-from ara.eval.run_store import RunStore
-from ara.eval.translator import Translator
+from ara.eval.translate.backends.base import Backend
+from ara.eval.translate.translator import Translator
 from ara.eval.user_data import file_split
+from ara.run_store import RunStore
 
 
 def load_data(config: AblationConfig) -> Split:

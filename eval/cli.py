@@ -10,9 +10,9 @@ import typer
 
 from ara.cli_support import emit, split_list, user_errors
 from ara.errors import ConfigError
-from ara.eval.answering import BUDGET_S
-from ara.eval.confidence import DOUBT
-from ara.eval.consistency import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
+from ara.eval.translate.answering import BUDGET_S
+from ara.eval.translate.confidence import DOUBT
+from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
@@ -138,7 +138,7 @@ def _translate(nl: str, aps: str, model: str, shots: int | None, examples_by: st
                examples: Path | None, seed: int, intervals: bool, max_bound: int,
                any_bound: bool, server: str, as_json: bool, **how) -> None:
     from ara.api import translate
-    from ara.eval.answering import notes
+    from ara.eval.translate.answering import notes
 
     with user_errors():  # the same path as ara.translate from Python
         answer = translate(nl, split_list(aps), model, shots=shots, seed=seed,
@@ -170,10 +170,7 @@ def translate_file_cmd(
     intervals: bool = INTERVALS,
     max_bound: int = MAX_BOUND,
     any_bound: bool = ANY_BOUND,
-    temperature: float = TEMPERATURE,
     repair: int | None = REPAIR_OPTION,
-    repair_by: str = REPAIR_BY_OPTION,
-    doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,
     budget: float = BUDGET,
     spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
@@ -190,31 +187,31 @@ def translate_file_cmd(
     each as they are made, so an interrupted run loses nothing: rerun with
     --resume. At the end a summary: how many answers are valid, doubted
     (confidence below 0.5), leave part of the request out, and, for lines
-    with a reference, how many are Spot-equivalent to it.
+    with a reference, how many are Spot-equivalent to it. The knobs of
+    experiments on files are in `ara eval ablation --data`.
     """
     from dataclasses import asdict
 
     from tqdm import tqdm
 
     from ara.data.normalize import form_of
-    from ara.eval.answering import AnswerConfig, worked_examples
-    from ara.eval.batch import (
+    from ara.eval.translate.answering import AnswerConfig, worked_examples
+    from ara.eval.translate.batch import (
         done_lines,
-        read_requests,
         same_settings,
         summarize,
         summary_table,
         translate_requests,
     )
-    from ara.eval.models import shared_backend
-    from ara.eval.translator import Translator, TranslatorConfig
+    from ara.eval.translate.models import shared_backend
+    from ara.eval.translate.request_file import read_requests
+    from ara.eval.translate.translator import Translator, TranslatorConfig
 
     with user_errors():
         config = TranslatorConfig(intervals=intervals, max_bound=max_bound,
                                   bounds_from_request=not any_bound)
         todo = read_requests(requests, config)
-        how = AnswerConfig.of(repair=repair, repair_by=repair_by, doubt=doubt,
-                              temperature=temperature, seed=seed, alternatives=alternatives,
+        how = AnswerConfig.of(repair=repair, seed=seed, alternatives=alternatives,
                               budget_s=budget)
         if out.is_dir():
             raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
@@ -311,10 +308,10 @@ def ablation_cmd(
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
     from ara.eval.ablation import load_data, run_ablation
-    from ara.eval.consistency import RepairConfig
     from ara.eval.harness import FILE_SPLIT, AblationConfig, plan
-    from ara.eval.models import make_backend
     from ara.eval.report import tables_markdown
+    from ara.eval.translate.models import make_backend
+    from ara.eval.translate.repair import RepairConfig
 
     # SIGTERM ends the run like Ctrl-C: finished samples stay, the report is written.
     signal.signal(signal.SIGTERM, signal.default_int_handler)

@@ -21,20 +21,18 @@ from typing import Protocol
 from ara import __version__
 from ara.data import Record
 from ara.data.store import FORMS, SPLITS
-from ara.errors import BoundTooLargeError, ConfigError, did_you_mean
-from ara.eval.answering import Answer
-from ara.eval.consistency import RepairConfig, translate_repaired
-from ara.eval.prompt import Shot, sample_shots
-from ara.eval.similar import EXAMPLES_BY, index_for
-from ara.eval.translator import Translator, TranslatorConfig
-from ara.grammars import GRAMMAR_VERSION, parse
-from ara.grammars.spot_bridge import SpotTimeoutError, equivalent, implies
+from ara.errors import ConfigError, did_you_mean
+from ara.eval.translate.answering import Answer
+from ara.eval.translate.prompt import Shot, sample_shots
+from ara.eval.translate.repair import RepairConfig, translate_repaired
+from ara.eval.translate.request_file import FILE_SPLIT
+from ara.eval.translate.similar import EXAMPLES_BY, index_for
+from ara.eval.translate.translator import Translator, TranslatorConfig
+from ara.grammars import GRAMMAR_VERSION
+from ara.grammars.spot_bridge import judge
 from ara.provenance import git_commit
 
 LETTERS = {"F": "few_shot", "P": "grammar_in_prompt", "C": "constrained"}
-
-#: What ``split`` is for a run on a user's own file (:mod:`ara.eval.user_data`).
-FILE_SPLIT = "file"
 
 
 class Split(Protocol):
@@ -105,13 +103,13 @@ class AblationConfig:
         spot_timeout_s: Time limit per Spot check; past it the pair counts as undecided.
         translator: Grammar and budget settings.
         repair: With C: when the greedy answer has a gap, look for one with fewer
-            (:func:`~ara.eval.consistency.translate_repaired`); ``samples`` 0 (the
+            (:func:`~ara.eval.translate.repair.translate_repaired`); ``samples`` 0 (the
             paper's variants): greedy only. Saved as ``repair``, ``repair_by`` and
             ``repair_doubt``, and only when on, as runs from before repair wrote none;
             runs repaired before ``by`` or ``doubt`` existed read as ``samples`` and 0.
         examples_by: How the F variants' worked examples are chosen: ``random`` (drawn
             with the seed, the same for every test pair of a rerun) or ``similar`` (for
-            each test pair, the pool's pairs most like it, :mod:`ara.eval.similar`,
+            each test pair, the pool's pairs most like it, :mod:`ara.eval.translate.similar`,
             never one that says the test's own sentence).
     """
 
@@ -271,23 +269,6 @@ def _jobs(config: AblationConfig, tests: list[Record], pool: list[Record],
                         examples = tuple(map(Shot.of, similar.nearest(
                             record.nl, record.aps, shots, other_sentences=True)))
                     yield Job(rerun, shots, variant, record, examples)
-
-
-def judge(reference: str, output: str | None, timeout_s: float) -> dict:
-    """Spot's verdicts on one output: equivalent to, and implying, the reference."""
-    if output is None:
-        return {"equivalent": None, "implies": None, "spot": "invalid"}
-    if output == reference:  # one canonical text is one tree: equal, without Spot
-        return {"equivalent": True, "implies": True, "spot": "same"}
-    ref, out = parse(reference), parse(output)
-    try:
-        eq = equivalent(out, ref, timeout_s=timeout_s)
-        imp = True if eq else implies(out, ref, timeout_s=timeout_s)
-        return {"equivalent": eq, "implies": imp, "spot": "ok"}
-    except SpotTimeoutError:
-        return {"equivalent": None, "implies": None, "spot": "timeout"}
-    except BoundTooLargeError:
-        return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
 def translate_job(translator: Translator, job: Job, config: AblationConfig) -> Answer:

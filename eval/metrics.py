@@ -20,8 +20,8 @@ from collections import Counter, defaultdict
 from collections.abc import Iterable
 from typing import TypedDict
 
-from ara.eval.checks import KINDS, gaps
-from ara.eval.request import Request
+from ara.eval.translate.checks import KINDS, gaps
+from ara.eval.translate.request import Request
 from ara.grammars import parse
 from ara.stats import describe
 
@@ -117,7 +117,7 @@ def overhead(results: list[VariantResult]) -> dict[str, float]:
 
 def gap_precision(references: Iterable = (),
                   answers: Iterable[dict] = ()) -> dict[str, Counter]:
-    """How often each kind of gap (:data:`~ara.eval.checks.KINDS`) flags a right answer,
+    """How often each kind of gap (:data:`~ara.eval.translate.checks.KINDS`) flags a right answer,
     and a wrong one: how precise the signal repair acts on is.
 
     Args:

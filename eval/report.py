@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TypedDict
 
 from ara.eval.metrics import VariantResult, overhead, score
-from ara.eval.run_store import RUN, read_samples
+from ara.run_store import RUN, read_samples
 
 
 class Results(TypedDict):

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from ara.eval.run_store import RunDirError, read_samples, sample_key
+from ara.run_store import RunDirError, read_samples, sample_key
 
 #: Kinds of change, in the order reports list them.
 KINDS = ("fixed", "broken", "rewritten_right", "rewritten_wrong")

@@ -1,6 +1,6 @@
 """A user's own pairs as the test side of an ablation (and, optionally, its worked examples).
 
-The files are those ``ara translate-file`` reads (:mod:`ara.eval.batch`), with the
+The files are those ``ara translate-file`` reads (:mod:`ara.eval.translate.batch`), with the
 reference ``stl`` required on every line::
 
     {"nl": "Never enter the server room.", "aps": ["enter_server_room"],
@@ -15,19 +15,13 @@ of the files' bytes: editing a file and resuming is refused, as for a new data v
 from __future__ import annotations
 
 import hashlib
-import re
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from ara.data import Record
-from ara.data.normalize import UidMaker
 from ara.errors import ConfigError
-from ara.eval.batch import FileRequest, read_requests
-from ara.eval.harness import FILE_SPLIT
-from ara.eval.translator import TranslatorConfig
-
-_LIFTED_AP = re.compile(r"prop_\d+")
+from ara.eval.translate.request_file import read_pairs
+from ara.eval.translate.translator import TranslatorConfig
 
 
 @dataclass(frozen=True)
@@ -61,38 +55,6 @@ class FileSplit:
             raise ConfigError(f"unknown part {part!r}: train or test")
         records = self.test if part == "test" else self.train
         return [r for r in records if form is None or r.form == form]
-
-
-def form_of(aps: Sequence[str]) -> str:
-    """``lifted`` when every proposition is ``prop_<n>``, as in NL2TL's lifted sentences;
-    else ``grounded``."""
-    return "lifted" if all(_LIFTED_AP.fullmatch(ap) for ap in aps) else "grounded"
-
-
-def read_pairs(path: Path, config: TranslatorConfig) -> list[Record]:
-    """Every line of ``path`` as a record: the request's own propositions (in its order,
-    distractors included) and its reference, which every line must give.
-
-    Raises:
-        ConfigError: If a line is bad as ``ara translate-file`` sees it, or gives no
-            reference; every such line is named.
-    """
-    requests = read_requests(path, config)
-    missing = [r.line for r in requests if r.reference is None]
-    if missing:
-        lines = ", ".join(map(str, missing[:10])) + (" ..." if len(missing) > 10 else "")
-        raise ConfigError(
-            f"{path}: an evaluation needs a reference on every line, as \"stl\"; without "
-            f"one: line(s) {lines} (`ara translate-file` translates such lines)")
-    uid = UidMaker()
-    return [_record(uid, request) for request in requests]
-
-
-def _record(uid: UidMaker, request: FileRequest) -> Record:
-    form = form_of(request.aps)
-    assert request.reference is not None
-    return Record(uid(FILE_SPLIT, form, request.nl, request.reference), request.nl,
-                  request.reference, request.aps, FILE_SPLIT, form, request.line - 1)
 
 
 def file_split(data: Path, examples: Path | None, config: TranslatorConfig) -> FileSplit:

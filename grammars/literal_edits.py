@@ -6,7 +6,7 @@ wrong, and often only by one slip: a proposition written in the wrong slot
 within 12 steps"), an interval left off an operator (``F(a & F(b))`` for "a, and
 within 10 steps after that, b"), a conjunct dropped. :func:`literal_edits` lists every
 formula one such edit away that writes a missing literal; a model's score picks among
-them (:func:`ara.eval.consistency.translate_repaired`).
+them (:func:`ara.eval.translate.repair.translate_repaired`).
 
 The edits, for a missing proposition ``q``: an atom becomes ``q``, ``(a | q)`` or
 ``(a & q)``; a subformula ``s`` becomes ``q -> s``; the whole formula gains a conjunct

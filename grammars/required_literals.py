@@ -1,7 +1,7 @@
 """Grammars whose strings must write given literals: "an answer that uses ``prop_3``".
 
 A translation that leaves out a proposition the user listed is wrong whatever else it
-says (:mod:`ara.eval.checks`). :func:`require_literals` turns a request's grammar
+says (:mod:`ara.eval.translate.checks`). :func:`require_literals` turns a request's grammar
 into one that admits exactly its strings whose derivation writes each given literal
 (a proposition, a bound of the listed-bounds interval rules) at least once, so a
 decoder under it cannot leave them out.

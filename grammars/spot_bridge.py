@@ -42,6 +42,7 @@ from ara.grammars.ast import (
     Until,
     max_bound,
 )
+from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
 
 #: Largest interval bound the Spot checks accept (see ``bench/spot_bounds.py``).
@@ -181,6 +182,25 @@ def implies(a: Formula, b: Formula, timeout_s: float | None = None) -> bool:
     """
     _check_bounds(a, b)
     return _decide("implies", to_spot_text(a), to_spot_text(b), timeout_s)
+
+
+def judge(reference: str, output: str | None, timeout_s: float) -> dict:
+    """Spot's verdicts on a model's ``output`` (a formula's text, or ``None`` when it gave
+    none): equivalent to, and implying, the ``reference``; ``spot`` says how it was
+    decided (``same`` text, ``ok``, or why not: ``invalid``, ``timeout``, ``bound``)."""
+    if output is None:
+        return {"equivalent": None, "implies": None, "spot": "invalid"}
+    if output == reference:  # one canonical text is one tree: equal, without Spot
+        return {"equivalent": True, "implies": True, "spot": "same"}
+    ref, out = parse(reference), parse(output)
+    try:
+        eq = equivalent(out, ref, timeout_s=timeout_s)
+        imp = True if eq else implies(out, ref, timeout_s=timeout_s)
+        return {"equivalent": eq, "implies": imp, "spot": "ok"}
+    except SpotTimeoutError:
+        return {"equivalent": None, "implies": None, "spot": "timeout"}
+    except BoundTooLargeError:
+        return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
 def _decide(op: str, a: str, b: str, timeout_s: float | None) -> bool:

@@ -8,7 +8,7 @@ right and how many wrong.
 
 Sets: the three hand-written suites, the compositional test side, NL2TL's timed dev file,
 the paper split's test side, and the compositional training mixture (whose NL2TL labels
-are noisy). Kinds: :data:`ara.eval.checks.KINDS`.
+are noisy). Kinds: :data:`ara.eval.translate.checks.KINDS`.
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from pathlib import Path
 
 from ara.data import load_or_prepare
 from ara.data.handwritten import suite_records
-from ara.eval.checks import KINDS, gaps
 from ara.eval.metrics import gap_precision
-from ara.eval.request import Request
+from ara.eval.translate.checks import KINDS, gaps
+from ara.eval.translate.request import Request
 from ara.grammars import parse
 
 RESULTS = Path("docs/results/generalization")

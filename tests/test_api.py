@@ -44,8 +44,8 @@ def test_translate_gives_the_command_s_answer_and_keeps_the_model_loaded():
     assert timed.stl == "F[0,20](prop_1)" and timed.vote is None  # greedy
     assert ara.translator.cache_info().misses == 1  # one load for both
     # other settings, and the command line's own path, share the model loaded
-    from ara.eval.models import shared_backend
-    from ara.eval.translator import TranslatorConfig
+    from ara.eval.translate.models import shared_backend
+    from ara.eval.translate.translator import TranslatorConfig
 
     untimed = ara.translator("finetuned", TranslatorConfig(intervals=False))
     assert untimed.backend is ara.translator("finetuned", None).backend

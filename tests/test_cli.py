@@ -1,7 +1,7 @@
 """The `ara` command line: the contract later work and external checks rely on.
 
 Commands run in this process (typer's runner on `ara.cli.app`), so a model loads once
-per session (`ara.eval.models.shared_backend`) rather than once per command; one test
+per session (`ara.eval.translate.models.shared_backend`) rather than once per command; one test
 runs the installed entry point for real.
 """
 
@@ -76,7 +76,7 @@ def test_grammar_output_loads_in_llama_cpp_and_lark():
     parser = lark.Lark(lark_text, start="start", parser="earley", lexer="dynamic")
     parser.parse("F a & G !b")
     pytest.importorskip("llama_cpp", reason="needs llama-cpp-python (make setup)")
-    from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.eval.translate.llama_check import LlamaGrammarChecker
 
     checker = LlamaGrammarChecker(gbnf)
     assert checker.accepts("F[2,5](a) & G(!b)") and not checker.accepts("F[2,25](a)")

@@ -1,6 +1,6 @@
 """Training examples in the evaluation prompt's layout, with loss on the answer only.
 
-The prompt is :func:`ara.eval.prompt.build_prompt`, with the worked examples a batch
+The prompt is :func:`ara.eval.translate.prompt.build_prompt`, with the worked examples a batch
 drew (none for zero-shot training), and the answer is what a model writes after
 ``"STL:"`` at evaluation time: a space, the canonical formula, the newline that ends
 it. The two are tokenized separately, as the prompt is at inference, so the model
@@ -17,8 +17,8 @@ import torch
 
 from ara.data.normalize import Record
 from ara.errors import ConfigError
-from ara.eval.prompt import STOP, Shot, build_prompt
-from ara.eval.translator import ANSWER_PREFIX
+from ara.eval.translate.prompt import STOP, Shot, build_prompt
+from ara.eval.translate.translator import ANSWER_PREFIX
 from ara.kv_cache import cache_of, with_cache
 
 IGNORE = -100

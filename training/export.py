@@ -144,9 +144,9 @@ def export_run(run_dir: Path, quants: tuple[str, ...] = ("f16",), lora_gguf: boo
 def parity(gguf: Path, hf_dir: Path, records, lora: Path | None = None,
            constrained: bool = False) -> dict:
     """Greedy answers of the GGUF (llama.cpp) and the HF folder (transformers), compared."""
-    from ara.eval.backends.hf_backend import HFBackend
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-    from ara.eval.translator import Translator
+    from ara.eval.translate.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.translator import Translator
 
     llama = Translator(LlamaCppBackend(str(gguf), lora_path=str(lora) if lora else None))
     hf = Translator(HFBackend(str(hf_dir)))

@@ -286,10 +286,10 @@ class LoRAFinetuneRecipe:
 
         The top-level ``validity`` and ``accuracy`` are those of the weakest layout.
         """
-        from ara.eval.backends.hf_backend import HFBackend
-        from ara.eval.harness import judge
-        from ara.eval.prompt import sample_shots
-        from ara.eval.translator import Translator
+        from ara.eval.translate.backends.hf_backend import HFBackend
+        from ara.eval.translate.prompt import sample_shots
+        from ara.eval.translate.translator import Translator
+        from ara.grammars.spot_bridge import judge
 
         n, form = self.config.eval_pairs, self.config.data.forms[0]
         model = self.accelerator.unwrap_model(self.model).eval()
@@ -345,8 +345,8 @@ def own_pairs(path: str) -> list:
     """A user's pairs file as training records of the source ``pairs``."""
     from dataclasses import replace
 
-    from ara.eval.translator import TranslatorConfig
-    from ara.eval.user_data import read_pairs
+    from ara.eval.translate.request_file import read_pairs
+    from ara.eval.translate.translator import TranslatorConfig
 
     return [replace(r, source="pairs") for r in read_pairs(Path(path), TranslatorConfig())]
 

@@ -5,10 +5,10 @@ import json
 import pytest
 
 from ara.coordination.demos import ERRANDS, run_demo
-from ara.eval.checks import gaps
-from ara.eval.confidence import DOUBT
-from ara.eval.request import Request
-from ara.eval.translator import Translator
+from ara.eval.translate.checks import gaps
+from ara.eval.translate.confidence import DOUBT
+from ara.eval.translate.request import Request
+from ara.eval.translate.translator import Translator
 from ara.grammars import parse
 
 from conftest import needs_llama

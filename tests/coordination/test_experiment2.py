@@ -8,7 +8,7 @@ import pytest
 from ara.coordination.experiment2 import METHODS, Exp2Config, run, run_trial, table
 from ara.coordination.trials import closest_robot, make_trial
 from ara.errors import ConfigError
-from ara.eval.run_store import RunDirError
+from ara.run_store import RunDirError
 
 
 @pytest.mark.parametrize(("seed", "site", "starts", "first_jobs", "last_job"), [
@@ -139,7 +139,7 @@ def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
     """Tests that run.json names the translator's model (file hashes), that the same
     folder refuses to continue with another model or none, and that each trial's
     translation is judged against the template spec and the template's auction."""
-    from ara.eval.translator import Translator
+    from ara.eval.translate.translator import Translator
 
     out = tmp_path / "exp2-llm"
     config = Exp2Config(trials=2, ils_iterations=5, llm="default", planner="milp",
@@ -184,9 +184,9 @@ def test_helpers_share_one_translation_of_a_request(llama_backend):
     request starts afresh; and repair, which helpers run as `ara translate` does, takes
     it as any translator."""
     from ara.coordination.experiment2 import SharedTranslator
-    from ara.eval.backends.base import Sampling
-    from ara.eval.consistency import RepairConfig, translate_repaired
-    from ara.eval.translator import Translator
+    from ara.eval.translate.backends.base import Sampling
+    from ara.eval.translate.repair import RepairConfig, translate_repaired
+    from ara.eval.translate.translator import Translator
 
     shared = SharedTranslator(Translator(llama_backend))
     nl, aps = "always avoid ( prop_1 )", ("prop_1",)

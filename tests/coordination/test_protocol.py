@@ -10,15 +10,14 @@ from ara.coordination.protocol import (
     Offer,
     ProtocolError,
     choose,
-    help_props,
     make_offer,
     request_shots,
     request_site,
     request_text,
     run_round,
-    template_help_spec,
 )
 from ara.coordination.world import GridWorld
+from ara.data.help_requests import help_props, template_help_spec
 
 WORLD = GridWorld.paper()
 CAPS = ("navigate", "report conflicts")
@@ -56,7 +55,7 @@ def test_an_unknown_wording_is_refused():
 def test_worked_requests_show_the_template_spec_in_the_decoding_grammar():
     """Tests that the translator's examples answer with the planner's own help spec,
     written so the decoding grammar (two arguments per &) admits it."""
-    from ara.eval.translator import TranslatorConfig
+    from ara.eval.translate.translator import TranslatorConfig
 
     for shot in request_shots():
         assert TranslatorConfig().syntax(shot.aps).accepts(shot.stl)
@@ -95,7 +94,7 @@ def test_round_trip_with_the_embedded_llm(llama_backend, finetuned):
     """The embedded model writes the request under a grammar that keeps its fields,
     and each helper plans whatever formula the shipped translator makes of it."""
     from ara.coordination.protocol import generate_request
-    from ara.eval.translator import Translator
+    from ara.eval.translate.translator import Translator
     from ara.grammars import parse
 
     text = generate_request(llama_backend, (3, 4), CAPS)
@@ -111,7 +110,7 @@ def test_round_trip_with_the_embedded_llm(llama_backend, finetuned):
 @pytest.fixture(scope="module")
 def shipped_translator(finetuned):
     """The shipped fine-tune through llama.cpp (the session's one load)."""
-    from ara.eval.translator import Translator
+    from ara.eval.translate.translator import Translator
 
     return Translator(finetuned)
 

@@ -1,13 +1,13 @@
-"""One answer to a request, as every way in gives it: ara.eval.answering."""
+"""One answer to a request, as every way in gives it: ara.eval.translate.answering."""
 
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.answering import Answer, AnswerConfig, answer, notes
-from ara.eval.checks import gaps
-from ara.eval.consistency import RepairConfig, Vote
-from ara.eval.request import Request
-from ara.eval.translator import TranslationResult, Translator
+from ara.eval.translate.answering import Answer, AnswerConfig, answer, notes
+from ara.eval.translate.checks import gaps
+from ara.eval.translate.repair import RepairConfig, Vote
+from ara.eval.translate.request import Request
+from ara.eval.translate.translator import TranslationResult, Translator
 from ara.grammars import parse
 
 #: The keys of `ara translate --json`, in the order translate-file writes them

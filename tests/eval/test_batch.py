@@ -1,4 +1,4 @@
-"""Translating a file of instructions: `ara translate-file` and ara.eval.batch."""
+"""Translating a file of instructions: `ara translate-file` and ara.eval.translate.batch."""
 
 import json
 from pathlib import Path
@@ -6,16 +6,15 @@ from pathlib import Path
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.batch import (
-    FileRequest,
+from ara.eval.translate.batch import (
     done_lines,
-    read_requests,
     same_settings,
     settings_path,
     summarize,
     summary_table,
 )
-from ara.eval.translator import TranslatorConfig
+from ara.eval.translate.request_file import FileRequest, read_requests
+from ara.eval.translate.translator import TranslatorConfig
 
 from conftest import needs_llama, run_ara
 

@@ -3,8 +3,8 @@
 from dataclasses import fields
 
 from ara.data.synthetic import synthetic_records
-from ara.eval.checks import CHECKS, KINDS, Gaps, gaps, mends, unasked, unclaimed
-from ara.eval.request import Request
+from ara.eval.translate.checks import CHECKS, KINDS, Gaps, gaps, mends, unasked, unclaimed
+from ara.eval.translate.request import Request
 from ara.grammars import parse, to_text
 from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, RESTATED, nested_pairs
 

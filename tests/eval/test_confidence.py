@@ -4,8 +4,13 @@ import math
 
 import pytest
 
-from ara.eval.confidence import DOUBT, answer_probability, doubt_warning, winner_probability
-from ara.eval.translator import Translator
+from ara.eval.translate.confidence import (
+    DOUBT,
+    answer_probability,
+    doubt_warning,
+    winner_probability,
+)
+from ara.eval.translate.translator import Translator
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +38,7 @@ def test_a_repaired_answer_is_scored_as_if_asked_anew(translator):
     """Tests that the winner's probability taken from repair's scores is the one scoring
     it afresh gives (a batch rounds differently from feeding a token at a time, so
     within 0.1 nats), on a request repair acts on."""
-    from ara.eval.consistency import RepairConfig, translate_repaired
+    from ara.eval.translate.repair import RepairConfig, translate_repaired
 
     nl = "Bring pallet 8 to the loading dock within 250 steps and pallet 9 within 400 steps."
     aps = ("deliver_pallet_8", "deliver_pallet_9")

@@ -1,11 +1,11 @@
-"""A time budget for one answer: ara.eval.deadline."""
+"""A time budget for one answer: ara.eval.translate.deadline."""
 
 import math
 import time
 
 import pytest
 
-from ara.eval.deadline import UNBOUNDED, Deadline
+from ara.eval.translate.deadline import UNBOUNDED, Deadline
 
 
 def spent_deadline() -> Deadline:

@@ -5,9 +5,9 @@ import random
 
 import pytest
 
-from ara.eval.harness import judge
-from ara.eval.models import FINETUNED_LORA, PAPER_LORA, make_backend
-from ara.eval.translator import Translator
+from ara.eval.translate.models import FINETUNED_LORA, PAPER_LORA, make_backend
+from ara.eval.translate.translator import Translator
+from ara.grammars.spot_bridge import judge
 
 #: The sentences of the issue that asked for generalization, with their references
 #: (the hand-written suite's first entries): none occurs in any training file.
@@ -75,7 +75,7 @@ def test_finetuned_translates_paper_pairs_with_and_without_worked_examples(finet
     reads a bare command as holding now, navi's convention, which the shipped adapter
     deliberately does not follow.)"""
     from ara.data import load_or_prepare
-    from ara.eval.prompt import sample_shots
+    from ara.eval.translate.prompt import sample_shots
 
     pairs = [(r.nl, r.aps, r.stl) for r in paper_split.records("test", "lifted")[:12]]
     shots = sample_shots(load_or_prepare("compositional").records("train", "lifted"), 5,
@@ -87,7 +87,7 @@ def test_finetuned_translates_paper_pairs_with_and_without_worked_examples(finet
 def test_names_reach_every_shipped_adapter(finetuned, tmp_path):
     """Tests ``--model lora:PATH`` (the shipped adapter by path is ``finetuned``),
     ``finetuned-paper``, and the message for a missing file."""
-    from ara.eval.backends.base import BackendError
+    from ara.eval.translate.backends.base import BackendError
 
     assert make_backend(f"lora:{FINETUNED_LORA}").model_id == finetuned.model_id
     if PAPER_LORA.is_file():
@@ -104,9 +104,9 @@ def test_repair_puts_back_a_bound_the_sentence_states(finetuned, by):
     gives both pallets the later deadline: by edits, the model's best-scored answer of
     those one edit away that write 250 is right; by samples, the answers drawn that use
     every stated bound agree on it."""
-    from ara.eval.checks import gaps
-    from ara.eval.consistency import RepairConfig, translate_repaired
-    from ara.eval.request import Request
+    from ara.eval.translate.checks import gaps
+    from ara.eval.translate.repair import RepairConfig, translate_repaired
+    from ara.eval.translate.request import Request
     from ara.grammars import parse
 
     nl = "Bring pallet 8 to the loading dock within 250 steps and pallet 9 within 400 steps."

@@ -3,8 +3,8 @@
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.consistency import RepairConfig
 from ara.eval.harness import AblationConfig, Variant, plan
+from ara.eval.translate.repair import RepairConfig
 
 
 @pytest.mark.parametrize(
@@ -105,7 +105,7 @@ def test_zero_shots_runs_f_zero_shot_and_too_many_is_refused(paper_split):
 def test_grammars_admit_intervals_and_the_timed_split_insists():
     """Tests that intervals are on by default, and that the timed split keeps them on
     even when a config turns them off (its references need them)."""
-    from ara.eval.translator import TranslatorConfig
+    from ara.eval.translate.translator import TranslatorConfig
 
     assert AblationConfig(split="paper").translator.intervals is True
     off = TranslatorConfig(intervals=False)

@@ -4,9 +4,9 @@ import random
 
 import pytest
 
-from ara.eval.backends.base import BackendError
-from ara.eval.prompt import STOP, build_prompt, sample_shots
-from ara.eval.translator import Translator
+from ara.eval.translate.backends.base import BackendError
+from ara.eval.translate.prompt import STOP, build_prompt, sample_shots
+from ara.eval.translate.translator import Translator
 
 
 @pytest.mark.slow  # test_decoding_sums_the_log_probability_scoring_gives decodes under the grammar
@@ -23,7 +23,7 @@ def test_constrained_outputs_belong_to_the_language(hf_backend, paper_split):
 @pytest.mark.slow  # loads a second model; llama.cpp's prefix reuse is tested in the default tier
 def test_prefix_reuse_gives_the_fresh_answer(hf_backend, hf_model_dir, paper_split):
     """Tests that cropping the cache to the shared prefix changes no answer."""
-    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
 
     shots = sample_shots(paper_split.records("train", "lifted"), 3, random.Random(4))
     prompts = [build_prompt(r.nl, r.aps, shots) for r in paper_split.records("test", "lifted")[:2]]
@@ -36,7 +36,7 @@ def test_prefix_reuse_gives_the_fresh_answer(hf_backend, hf_model_dir, paper_spl
 @pytest.mark.slow  # outlines' CFG path takes over a minute for two answers on 2 cores
 def test_outlines_and_llguidance_paths_agree(hf_backend, hf_model_dir, paper_split):
     """Tests that outlines' CFG generation and our masked greedy loop give the same answer."""
-    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
 
     via_outlines = Translator(HFBackend(hf_model_dir, mask="outlines"))
     via_loop = Translator(hf_backend)
@@ -49,7 +49,7 @@ def test_outlines_and_llguidance_paths_agree(hf_backend, hf_model_dir, paper_spl
 
 def test_unknown_model_is_a_clear_error(tmp_path):
     """Tests the message for a folder that holds no model (nothing is downloaded)."""
-    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
 
     with pytest.raises(BackendError, match="cannot load"):
         HFBackend(str(tmp_path / "nothing-here"))
@@ -71,7 +71,7 @@ def test_decoding_sums_the_log_probability_scoring_gives(hf_backend, llama_backe
     its log-probability, summed while decoding, is what scoring its text gives, in both
     runtimes (the free check `ara translate` runs on every answer)."""
     from ara.data import load_or_prepare
-    from ara.eval.translator import decoding_grammar
+    from ara.eval.translate.translator import decoding_grammar
 
     # Worked examples keep the base model to tokens it would choose unmasked: where the
     # mask overrules it, it may write a formula in tokens not the tokenizer's own
@@ -94,7 +94,7 @@ def test_scores_shared_prefixes_change_only_float_rounding(hf_backend, hf_model_
     share with the one before, scores each as a fresh model scoring it alone does, up
     to float32 rounding (llama.cpp's kernels differed by up to 0.9 in a logit, so that
     backend scores each answer alone; this one need not)."""
-    from ara.eval.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
 
     prompt = build_prompt("always avoid the door and eventually reach the goal",
                           ("door", "goal"), ())

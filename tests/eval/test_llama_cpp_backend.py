@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.backends.base import BackendError, Sampling
-from ara.eval.backends.masking import allowed_tokens
-from ara.eval.prompt import STOP, build_prompt, sample_shots
-from ara.eval.translator import Translator, TranslatorConfig
+from ara.eval.translate.backends.base import BackendError, Sampling
+from ara.eval.translate.backends.masking import allowed_tokens
+from ara.eval.translate.prompt import STOP, build_prompt, sample_shots
+from ara.eval.translate.translator import Translator, TranslatorConfig
 from ara.grammars import Syntax, build_grammar
 
 
@@ -24,7 +24,7 @@ def test_allowed_tokens_unpacks_an_llguidance_bitmask():
 
 def test_missing_model_file_is_a_clear_error(tmp_path):
     """Tests the message for a GGUF path that does not exist."""
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
     with pytest.raises(BackendError, match="model file not found"):
         LlamaCppBackend(str(tmp_path / "missing.gguf"))
@@ -32,7 +32,7 @@ def test_missing_model_file_is_a_clear_error(tmp_path):
 
 def decoding_grammar(aps, **kwargs):
     """The translator's own decoding grammar for ``aps``."""
-    from ara.eval.translator import decoding_grammar as translator_grammar
+    from ara.eval.translate.translator import decoding_grammar as translator_grammar
 
     return translator_grammar(build_grammar(Syntax(aps=tuple(aps), max_depth=5, max_args=2,
                                                    **kwargs)))
@@ -96,7 +96,7 @@ def test_prefix_reuse_changes_nothing_but_the_work(llama_backend, embedded_model
     """Tests that a prompt sharing its prefix with the previous one gets exactly what a
     fresh model gives it (text, log-probability, seeded samples, scores), while
     evaluating fewer prompt tokens: an answer does not depend on what came before."""
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
     shots = sample_shots(paper_split.records("train", "lifted"), 5, random.Random(1))
     tests = paper_split.records("test", "lifted")[:3]
@@ -124,7 +124,7 @@ def test_llguidance_and_llama_cpp_masks_choose_the_same_tokens(embedded_model_pa
                                                                llama_backend, paper_split):
     """Tests that the fast mask is exact: greedy decoding under llama.cpp's own grammar
     sampler gives the same answers."""
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
     builtin = LlamaCppBackend(embedded_model_path, n_ctx=4096, mask="llama")
     shots = sample_shots(paper_split.records("train", "grounded"), 3, random.Random(2))
@@ -162,7 +162,7 @@ def test_scores_do_not_depend_on_what_else_is_scored(llama_backend):
 def test_the_thread_count_comes_from_the_caller_or_ara_threads(embedded_model_path,
                                                                monkeypatch):
     """Tests ARA_THREADS: beside another busy process, one thread beats all cores."""
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
     monkeypatch.setenv("ARA_THREADS", "1")
     assert LlamaCppBackend(embedded_model_path).llm.context_params.n_threads == 1

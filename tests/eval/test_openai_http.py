@@ -9,10 +9,10 @@ import urllib.request
 
 import pytest
 
-from ara.eval.backends.base import BackendError
-from ara.eval.backends.openai_http import OpenAIBackend
-from ara.eval.prompt import STOP, Shot, build_prompt
-from ara.eval.translator import Translator
+from ara.eval.translate.backends.base import BackendError
+from ara.eval.translate.backends.openai_http import OpenAIBackend
+from ara.eval.translate.prompt import STOP, Shot, build_prompt
+from ara.eval.translate.translator import Translator
 
 pytest.importorskip("uvicorn", reason="needs llama-cpp-python[server] (make setup)")
 
@@ -66,9 +66,9 @@ def test_an_endpoint_cannot_score_answers_and_repair_keeps_its_answer(server):
     """Tests that scoring answers, which repair ranks by, is refused by name on a
     server, and that repair, which can neither score nor sample there, keeps the
     greedy answer of a request it would repair on a local model."""
-    from ara.eval.checks import gaps
-    from ara.eval.consistency import translate_repaired
-    from ara.eval.request import Request
+    from ara.eval.translate.checks import gaps
+    from ara.eval.translate.repair import translate_repaired
+    from ara.eval.translate.request import Request
     from ara.grammars import parse
 
     translator = Translator(OpenAIBackend(server, server="llama"))
@@ -111,7 +111,7 @@ def test_constrained_requests_to_plain_openai_and_dead_endpoints_are_refused(ser
 
 
 def _decoding_grammar(aps=("prop_1", "prop_2")):
-    from ara.eval.translator import TranslatorConfig, decoding_grammar
+    from ara.eval.translate.translator import TranslatorConfig, decoding_grammar
     from ara.grammars import build_grammar
 
     return decoding_grammar(build_grammar(TranslatorConfig().syntax(aps, "no numbers")))
@@ -190,7 +190,7 @@ def test_concurrent_requests_keep_the_serial_log(server, tmp_path, llama_backend
     from ara.errors import ConfigError
     from ara.eval.ablation import run_ablation
     from ara.eval.harness import AblationConfig
-    from ara.eval.run_store import read_samples
+    from ara.run_store import read_samples
 
     config = AblationConfig(variants=("F", "C"), shots=(2,), reruns=1, limit=3,
                             spot_timeout_s=5)

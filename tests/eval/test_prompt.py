@@ -2,7 +2,7 @@
 
 import random
 
-from ara.eval.prompt import (
+from ara.eval.translate.prompt import (
     INSTRUCTIONS,
     Shot,
     build_prompt,

@@ -1,6 +1,6 @@
 """A request analysed once: the numbers, claims, nestings and order its words ask for."""
 
-from ara.eval.request import Request, written_numbers
+from ara.eval.translate.request import Request, written_numbers
 from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, HOLDS
 
 

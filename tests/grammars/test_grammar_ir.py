@@ -76,7 +76,7 @@ def test_with_suffix_adds_exactly_the_suffix_newlines_included():
     newline, and a formula without it, or with anything after it, is refused."""
     import lark
 
-    from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.eval.translate.llama_check import LlamaGrammarChecker
 
     grammar = build_grammar(Syntax(aps=("a", "b"))).grammar.with_prefix(" ").with_suffix("\n")
     assert '"\\n"' in grammar.to_gbnf() and '"\\n"' in grammar.to_lark()

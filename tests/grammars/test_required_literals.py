@@ -110,7 +110,7 @@ def test_a_depth_too_small_for_all_literals_is_an_error():
 def test_llama_cpp_reads_the_gbnf_and_agrees():
     """Tests llama.cpp's grammar engine on the emitted GBNF (it rejects left recursion
     and unknown rules) against the parser, on strings of the plain language."""
-    from ara.eval.llama_check import LlamaGrammarChecker
+    from ara.eval.translate.llama_check import LlamaGrammarChecker
 
     syntax, literals = CASES["a proposition and a bound"]
     plain = build_grammar(syntax).grammar

@@ -6,7 +6,7 @@ import pytest
 
 from ara.data.normalize import Record
 from ara.errors import ConfigError
-from ara.eval.prompt import build_prompt
+from ara.eval.translate.prompt import build_prompt
 from ara.training.dataset import batch_shots, batches, encode, repeat_sources
 
 

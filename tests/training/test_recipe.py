@@ -127,8 +127,8 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
     """
     import numpy as np
 
-    from ara.eval.backends.hf_backend import HFBackend
-    from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+    from ara.eval.translate.backends.hf_backend import HFBackend
+    from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
     from ara.training.export import export_run
 
     config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2)

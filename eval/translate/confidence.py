@@ -1,7 +1,7 @@
 """How sure the model is of its answer: a check that needs no reference.
 
 The model's probability of its own answer, teacher-forced after the very prompt it
-answered (:meth:`~ara.eval.translator.Translator.score`), separates right from wrong
+answered (:meth:`~ara.eval.translate.translator.Translator.score`), separates right from wrong
 answers well on the held-out sets (measured in docs/model-card.md, "How repair and the
 confidence note work"); a sentence the model cannot read ("( prop_1 ) purple elephant
 ( prop_2 )") gets a low one.
@@ -10,7 +10,7 @@ It mostly flags: the model seldom scores the reference above its own wrong answe
 keeping the majority of samples where it doubts did worse than the greedy answer. Where
 it does, greedy decoding missed a likelier answer, and repair looks for it: where the
 model doubts a complete answer, it keeps the best-scored of it and the samples
-(:func:`~ara.eval.consistency.translate_repaired`). A user who sees the flag reads the
+(:func:`~ara.eval.translate.repair.translate_repaired`). A user who sees the flag reads the
 answer back (`ara stl explain`) or rewords the sentence.
 """
 
@@ -20,13 +20,13 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from ara.eval.prompt import Shot
-from ara.eval.translator import TranslationResult, Translator
+from ara.eval.translate.prompt import Shot
+from ara.eval.translate.translator import TranslationResult, Translator
 from ara.grammars import parse
 from ara.grammars.english import explain
 
-if TYPE_CHECKING:  # consistency imports DOUBT from here
-    from ara.eval.consistency import Vote
+if TYPE_CHECKING:  # repair imports DOUBT from here
+    from ara.eval.translate.repair import Vote
 
 #: Below this probability an answer is flagged. Chosen on the compositional test side,
 #: where the answers below it were more often wrong than right, and then checked on the
@@ -84,7 +84,7 @@ def doubt_warning(stl: str, probability: float,
                   others: Sequence[tuple[str, float]] = ()) -> str:
     """What to tell a user whose answer the model doubts, with the answer read back, and
     ``others``' readings under it (formula, probability), as
-    :func:`~ara.eval.consistency.readings` gives them after the winner."""
+    :func:`~ara.eval.translate.repair.readings` gives them after the winner."""
     lines = [f"note: the model gives this answer a probability of {probability:.2g}; below "
              f"{DOUBT:g}, about half of its answers on held-out sentences were wrong. It "
              f"reads: \"{explain(parse(stl))}\". If that is not what you meant, reword the "

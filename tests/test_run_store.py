@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from ara.eval.run_store import RunDirError, RunStore, read_samples
+from ara.run_store import RunDirError, RunStore, read_samples
 
 META = {"config": {"seed": 0}, "model_id": "m", "data": {"version": "v"},
         "grammar_version": "1"}

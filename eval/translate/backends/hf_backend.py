@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ara.eval.backends.base import BackendError, Completion, Sampling
-from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
+from ara.eval.translate.backends.base import BackendError, Completion, Sampling
+from ara.eval.translate.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
 from ara.grammars import BuiltGrammar
 from ara.kv_cache import cache_of, with_cache
 
@@ -138,7 +138,7 @@ class HFBackend:
 
     def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
         """Log-probability of each continuation after ``prompt``, teacher-forced without a
-        grammar (see :func:`~ara.eval.backends.masking.score_paths`)."""
+        grammar (see :func:`~ara.eval.translate.backends.masking.score_paths`)."""
         ids = self.tokenizer(prompt, add_special_tokens=True)["input_ids"]
         paths = [self.tokenizer(c, add_special_tokens=False)["input_ids"] for c in continuations]
         self._feed_prompt(ids)

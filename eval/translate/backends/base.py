@@ -2,12 +2,12 @@
 
 A backend turns ``(prompt, grammar or None, max_tokens)`` into a :class:`Completion`.
 With a grammar, the backend guarantees that the returned text is a complete string of
-that grammar, or says it could not (``stop == "length"``); :mod:`ara.eval.translator`
+that grammar, or says it could not (``stop == "length"``); :mod:`ara.eval.translate.translator`
 turns completions into parsed formulas.
 
 The local backends can also score answers: ``score(prompt, continuations)``, the
 log-probability of each continuation after the prompt (what repair ranks answers by,
-:mod:`ara.eval.consistency`). It is not part of :class:`Backend`, since an HTTP server
+:mod:`ara.eval.translate.repair`). It is not part of :class:`Backend`, since an HTTP server
 gives no such call; callers check for it.
 """
 

@@ -15,9 +15,9 @@ from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 
 from ara.errors import AraError, ConfigError, STLSyntaxError
-from ara.eval.backends.base import Backend, BackendError, Sampling
-from ara.eval.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
-from ara.eval.request import Request
+from ara.eval.translate.backends.base import Backend, BackendError, Sampling
+from ara.eval.translate.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
+from ara.eval.translate.request import Request
 from ara.grammars import (
     BuiltGrammar,
     Formula,
@@ -198,7 +198,7 @@ class Translator:
     """Translate instructions with one backend.
 
     Args:
-        backend: Any :class:`~ara.eval.backends.base.Backend`.
+        backend: Any :class:`~ara.eval.translate.backends.base.Backend`.
         config: Grammar and budget settings.
     """
 
@@ -223,7 +223,7 @@ class Translator:
             grammar_in_prompt: Show the grammar in the prompt (variant P).
             constrained: Decode under the grammar (variant C).
             sampling: Draw the answer (seeded) instead of decoding greedily; see
-                :mod:`ara.eval.consistency`.
+                :mod:`ara.eval.translate.repair`.
             require: With ``constrained``: literals the answer must write, each a
                 proposition of ``aps`` or a bound the grammar admits (e.g.
                 ``("prop_3", "10")``); see :func:`~ara.grammars.require_literals`.

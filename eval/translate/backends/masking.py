@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ara.eval.backends.base import Sampling
+from ara.eval.translate.backends.base import Sampling
 from ara.grammars import BuiltGrammar
 
 

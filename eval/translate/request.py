@@ -29,7 +29,7 @@ class Request:
         nl: The sentence.
         aps: Its propositions, as listed.
         numbers: Every number it writes, in digits or words: the bounds its grammar
-            may use (:meth:`~ara.eval.translator.TranslatorConfig.syntax`).
+            may use (:meth:`~ara.eval.translate.translator.TranslatorConfig.syntax`).
         stated: The numbers it states as time (:func:`stated_numbers`): the bounds an
             answer has to write.
         claims: What it asks in words to hold, happen or recur, in the order of

@@ -17,9 +17,16 @@ from functools import lru_cache
 from pathlib import Path
 
 from ara.errors import ConfigError
-from ara.eval.checks import Gaps, gaps
-from ara.eval.confidence import DOUBT, doubt_warning, result_probability, winner_probability
-from ara.eval.consistency import (
+from ara.eval.translate.checks import Gaps, gaps
+from ara.eval.translate.confidence import (
+    DOUBT,
+    doubt_warning,
+    result_probability,
+    winner_probability,
+)
+from ara.eval.translate.deadline import Deadline
+from ara.eval.translate.prompt import Shot, sample_shots
+from ara.eval.translate.repair import (
     REPAIR_BY,
     RepairConfig,
     Vote,
@@ -27,10 +34,9 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
-from ara.eval.deadline import Deadline
-from ara.eval.prompt import Shot, sample_shots
-from ara.eval.request import Request
-from ara.eval.translator import TranslationResult, Translator
+from ara.eval.translate.request import Request
+from ara.eval.translate.request_file import read_pairs
+from ara.eval.translate.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
 
 #: Seconds Spot may take to tell whether two readings mean the same; an undecided pair
@@ -56,7 +62,7 @@ class AnswerConfig:
         grammar_in_prompt: Show the grammar in the prompt.
         constrained: Decode under the grammar.
         alternatives: Other readings to report when the model doubts its answer, 0 to 8.
-        budget_s: Seconds for the whole answer (:class:`~ara.eval.deadline.Deadline`):
+        budget_s: Seconds for the whole answer (:class:`~ara.eval.translate.deadline.Deadline`):
             once spent, repair draws, mends and scores no more answers, Spot checks
             stop and the greedy answer (or a better one already scored) is given. >= 0;
             0 or ``None``: unbounded.
@@ -116,7 +122,7 @@ class Answer:
         alternatives: Other readings, each formula with its probability, listed only
             when the confidence is below :data:`DOUBT`.
         gaps: What the answer leaves out of the request or nests unasked
-            (:class:`~ara.eval.checks.Gaps`); ``None`` where it does not parse, or
+            (:class:`~ara.eval.translate.checks.Gaps`); ``None`` where it does not parse, or
             nobody asked.
         waited_ms: The whole time :func:`answer` took (generation, scoring, readings,
             gap checks); ``None`` where the answer was made otherwise.
@@ -161,7 +167,7 @@ class Answer:
         ``ran_out``), ``error``, ``model``, ``constrained``, ``shots``, ``grammar``;
         ``samples`` (every answer, their groups and scores) where more than one was
         weighed; ``confidence``; ``alternatives`` (each ``stl`` and ``probability``);
-        ``left_out`` and ``unasked`` (:meth:`~ara.eval.checks.Gaps.to_json`) where the
+        ``left_out`` and ``unasked`` (:meth:`~ara.eval.translate.checks.Gaps.to_json`) where the
         answer parses."""
         r, vote = self.result, self.vote
         data = {"stl": r.stl, "valid": r.valid, "raw": r.raw, "ms": round(self.ms, 1),
@@ -184,8 +190,8 @@ def answer(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[
            config: AnswerConfig | None = None) -> Answer:
     """Translate ``nl`` over ``aps`` as ``config`` says, with what a user should know: the
     model's confidence, the other readings where it doubts the answer
-    (:data:`DOUBT`), and the answer's gaps (:func:`~ara.eval.checks.gaps`), all within
-    ``config.budget_s`` (:class:`~ara.eval.deadline.Deadline`)."""
+    (:data:`DOUBT`), and the answer's gaps (:func:`~ara.eval.translate.checks.gaps`), all within
+    ``config.budget_s`` (:class:`~ara.eval.translate.deadline.Deadline`)."""
     config = config or AnswerConfig()
     deadline = Deadline(config.budget_s)
     vote: Vote | None = None
@@ -237,13 +243,13 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int
         seed: Which examples ``random`` draws.
         nl: The request's sentence, which ``similar`` compares the pool's with.
         by: ``random`` (the same examples for every request of a form) or ``similar``
-            (the pool's pairs most like this request, :mod:`ara.eval.similar`).
+            (the pool's pairs most like this request, :mod:`ara.eval.translate.similar`).
         pool: A file of one's own pairs to choose from (the lines `translate-file`
             reads, each with its reference); default: the compositional train side.
     """
     from ara.data.normalize import form_of
-    from ara.eval.models import default_shots
-    from ara.eval.similar import EXAMPLES_BY, index_for
+    from ara.eval.translate.models import default_shots
+    from ara.eval.translate.similar import EXAMPLES_BY, index_for
 
     if by not in EXAMPLES_BY:
         raise ConfigError(f"examples by {by!r}? choose one of {', '.join(EXAMPLES_BY)}")
@@ -267,9 +273,6 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int
 
 @lru_cache(maxsize=4)
 def _pool_file(path: str) -> tuple:
-    from ara.eval.translator import TranslatorConfig
-    from ara.eval.user_data import read_pairs
-
     return tuple(read_pairs(Path(path), TranslatorConfig()))
 
 

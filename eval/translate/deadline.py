@@ -1,6 +1,6 @@
 """A time budget for one answer, shared by every step that can be cut short.
 
-:func:`~ara.eval.answering.answer` starts one :class:`Deadline` and passes it down:
+:func:`~ara.eval.translate.answering.answer` starts one :class:`Deadline` and passes it down:
 repair stops drawing, mending and scoring answers when it is spent, and each Spot
 check runs for its own limit or the time left, whichever is less. The greedy answer
 is always made, so a spent budget still gives an answer: the best found so far.

@@ -18,9 +18,9 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
-from ara.eval.backends.base import Backend, BackendError
+from ara.eval.translate.backends.base import Backend, BackendError
 
-SHIPPED = Path(__file__).parent / "models"
+SHIPPED = Path(__file__).parents[1] / "models"
 FINETUNED_LORA = SHIPPED / "gemma3-270m-nl2tl-lora.gguf"
 PAPER_LORA = SHIPPED / "gemma3-270m-nl2tl-paper-lora.gguf"
 #: ``--model`` names of the shipped adapters.
@@ -41,8 +41,8 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
         BackendError: If the model cannot be found, with what to do instead.
     """
     if model == "default":
-        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.eval.llama_check import default_model_path
+        from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
+        from ara.eval.translate.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
     if model in SHIPPED_ADAPTERS or model.startswith("lora:"):
@@ -52,21 +52,21 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
                 f"no LoRA adapter at {lora}: `ara export --lora-gguf` writes one; "
                 "or use --model default, or a GGUF path from `ara export`"
             )
-        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.eval.llama_check import default_model_path
+        from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
+        from ara.eval.translate.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask,
                                lora_path=str(lora))
     if model.startswith(("http://", "https://")):
-        from ara.eval.backends.openai_http import OpenAIBackend
+        from ara.eval.translate.backends.openai_http import OpenAIBackend
 
         return OpenAIBackend(model, api_model or "default", server=server)
     if model.startswith("hf:"):
-        from ara.eval.backends.hf_backend import HFBackend
+        from ara.eval.translate.backends.hf_backend import HFBackend
 
         return HFBackend(model[3:], mask=mask)
     if model.endswith(".gguf"):
-        from ara.eval.backends.llama_cpp_backend import LlamaCppBackend
+        from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
         return LlamaCppBackend(model, n_ctx=n_ctx, mask=mask)
     raise BackendError(

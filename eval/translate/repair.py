@@ -7,14 +7,14 @@ greedy answer, so with one sample this is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
 
 Repair (:func:`translate_repaired`) looks for another answer only when the greedy one
-leaves out a listed proposition or a stated bound (:mod:`ara.eval.checks`), and then
+leaves out a listed proposition or a stated bound (:mod:`ara.eval.translate.checks`), and then
 prefers the answers that leave out least; the greedy answer stays unless another says
 more of the request. By default the other answers are samples drawn under the grammar
 and the formulas one edit from the greedy one that write what it left out, and the
 model's score of each whole answer picks among them; where the backend cannot score,
 the samples' majority does. A complete greedy answer is checked by its score, which
 decoding computes on the way: if the model gives it a probability below
-:data:`~ara.eval.confidence.DOUBT`, samples are drawn and the best-scored complete
+:data:`~ara.eval.translate.confidence.DOUBT`, samples are drawn and the best-scored complete
 answer wins (a search for the likelier answer that greedy decoding missed); otherwise
 it stands.
 """
@@ -27,13 +27,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from ara.errors import ConfigError
-from ara.eval.backends.base import Sampling
-from ara.eval.checks import gaps, mends
-from ara.eval.confidence import DOUBT, result_score
-from ara.eval.deadline import UNBOUNDED, Deadline
-from ara.eval.prompt import Shot
-from ara.eval.request import Request
-from ara.eval.translator import ANSWER_PREFIX, TranslationResult, Translator
+from ara.eval.translate.backends.base import Sampling
+from ara.eval.translate.checks import gaps, mends
+from ara.eval.translate.confidence import DOUBT, result_score
+from ara.eval.translate.deadline import UNBOUNDED, Deadline
+from ara.eval.translate.prompt import Shot
+from ara.eval.translate.request import Request
+from ara.eval.translate.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
 from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
@@ -69,7 +69,7 @@ class RepairConfig:
     Attributes:
         samples: Extra answers to draw when the greedy one has a gap or is doubted, 0 to
             32 (0: greedy only); ``None``: :data:`DEFAULT_REPAIR`, where repair is on by
-            default (:class:`~ara.eval.answering.AnswerConfig` turns it off for a vote).
+            default (:class:`~ara.eval.translate.answering.AnswerConfig` turns it off for a vote).
         by: One of :data:`REPAIR_BY`.
         doubt: By ``samples+edits``: also draw for a complete greedy answer the model
             gives a probability below this, 0 to 1 (0: gaps only).
@@ -205,7 +205,7 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
             what the other two do where the backend cannot score.
             ``doubt``: by ``samples+edits`` on a backend that scores, when the greedy answer
             leaves nothing out but the model gives it a probability below ``doubt``
-            (:mod:`ara.eval.confidence`), draw ``samples`` answers and keep the
+            (:mod:`ara.eval.translate.confidence`), draw ``samples`` answers and keep the
             best-scored of those and the greedy one that leave nothing out (an answer
             above 0.5 is the likeliest there is, so nothing is drawn for it); 0: act
             on gaps only.
@@ -344,7 +344,7 @@ def rank_repairs(answers: Sequence[str | None], missing: Sequence[float],
 def literal_mends(translator: Translator, request: Request, stl: str,
                   bounds: bool = True) -> list[str]:
     """Formulas one edit from ``stl`` that close one of its gaps
-    (:func:`~ara.eval.checks.mends`; without ``bounds``, not a stated bound), kept to
+    (:func:`~ara.eval.translate.checks.mends`; without ``bounds``, not a stated bound), kept to
     the request's language so that each is an answer constrained decoding could have
     given."""
     syntax = translator.grammar(request.aps, request.nl).syntax

@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ara.eval.backends.base import BackendError, Completion, Sampling
-from ara.eval.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
-from ara.eval.llama_check import muted_llama_log
+from ara.eval.translate.backends.base import BackendError, Completion, Sampling
+from ara.eval.translate.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
+from ara.eval.translate.llama_check import muted_llama_log
 from ara.grammars import BuiltGrammar
 from ara.provenance import sha256_file
 
@@ -171,7 +171,7 @@ class LlamaCppBackend:
 
     def score(self, prompt: str, continuations: Sequence[str]) -> list[float]:
         """Log-probability of each continuation after ``prompt``, teacher-forced without a
-        grammar (see :func:`~ara.eval.backends.masking.score_paths`); each the same
+        grammar (see :func:`~ara.eval.translate.backends.masking.score_paths`); each the same
         whatever else is scored with it."""
         tokens = self.llm.tokenize(prompt.encode(), add_bos=True, special=False)
         paths = [self.llm.tokenize(c.encode(), add_bos=False, special=False)

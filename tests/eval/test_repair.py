@@ -8,9 +8,10 @@ import time
 import pytest
 
 from ara.errors import ConfigError
-from ara.eval.backends.base import BackendError, Sampling
-from ara.eval.checks import gaps
-from ara.eval.consistency import (
+from ara.eval.translate.backends.base import BackendError, Sampling
+from ara.eval.translate.checks import gaps
+from ara.eval.translate.deadline import UNBOUNDED, Deadline
+from ara.eval.translate.repair import (
     RepairConfig,
     Vote,
     _group,
@@ -22,9 +23,8 @@ from ara.eval.consistency import (
     translate_consistent,
     translate_repaired,
 )
-from ara.eval.deadline import UNBOUNDED, Deadline
-from ara.eval.request import Request
-from ara.eval.translator import TranslationResult, Translator, TranslatorConfig
+from ara.eval.translate.request import Request
+from ara.eval.translate.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
 
 from conftest import needs_llama

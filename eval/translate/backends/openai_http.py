@@ -29,7 +29,7 @@ import time
 import urllib.error
 import urllib.request
 
-from ara.eval.backends.base import BackendError, Completion, Sampling
+from ara.eval.translate.backends.base import BackendError, Completion, Sampling
 from ara.grammars import BuiltGrammar
 
 #: Where each server flavour reads a grammar; ``openai`` has none.
@@ -129,7 +129,7 @@ class OpenAIBackend:
     def _check_obeyed(self, grammar: BuiltGrammar, text: str, stop: str) -> None:
         """That a constrained answer is in the grammar's language (the budget always
         fits the grammar's longest string, so a cut answer is a disobeyed one too)."""
-        from ara.eval.translator import admits
+        from ara.eval.translate.translator import admits
 
         if admits(grammar, text.removesuffix(stop)):
             return

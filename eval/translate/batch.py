@@ -1,121 +1,27 @@
-"""Translate a file of instructions: one model load, one output line per instruction.
+"""Translate a file of instructions (:mod:`~ara.eval.translate.request_file` reads it):
+one model load, one output line per instruction.
 
-The input is JSON Lines, one request per line::
-
-    {"nl": "Never enter the server room.", "aps": ["enter_server_room"]}
-    {"nl": "go to ( prop_1 ) and after that ( prop_2 )", "aps": ["prop_1", "prop_2"],
-     "stl": "F(prop_1 & F(prop_2))", "id": "seq-1"}
-
-``stl`` (optional) is a reference: the answer is then judged by Spot. Every line is
-checked before the first is translated, so a typo on line 90 costs nothing. Each
-answer is written and flushed as soon as it is made (the line of ``ara translate
---json``, with the request), so an interrupted run keeps what it did and ``resume``
-goes on from there; the settings it answers with are kept beside the answers
-(:func:`settings_path`), so that a resumed run answers as the run it goes on with.
+A line's reference (``stl``), if it gives one, judges its answer by Spot. Each answer
+is written and flushed as soon as it is made (the line of ``ara translate --json``, with
+the request), so an interrupted run keeps what it did and ``resume`` goes on from there;
+the settings it answers with are kept beside the answers (:func:`settings_path`), so
+that a resumed run answers as the run it goes on with.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
-from ara.errors import AraError, ConfigError
-from ara.eval.answering import AnswerConfig, answer, doubted
-from ara.eval.checks import Gaps
-from ara.eval.harness import judge
-from ara.eval.prompt import Shot
-from ara.eval.translator import Translator, TranslatorConfig, check_request
-from ara.grammars import atoms, parse, to_text
+from ara.errors import ConfigError
+from ara.eval.translate.answering import AnswerConfig, answer, doubted
+from ara.eval.translate.checks import Gaps
+from ara.eval.translate.prompt import Shot
+from ara.eval.translate.request_file import FileRequest
+from ara.eval.translate.translator import Translator
+from ara.grammars.spot_bridge import judge
 from ara.provenance import differing
-
-#: Bad lines named in one error; the rest are counted.
-MAX_REPORTED = 10
-
-
-@dataclass(frozen=True)
-class FileRequest:
-    """One line of the input file.
-
-    Attributes:
-        line: Its 1-based line number.
-        nl: The instruction.
-        aps: Its atomic propositions.
-        reference: A reference formula in canonical text, if the line gives one.
-        id: The line's own ``id``, if any.
-    """
-
-    line: int
-    nl: str
-    aps: tuple[str, ...]
-    reference: str | None = None
-    id: str | None = None
-
-
-def read_requests(path: Path, config: TranslatorConfig) -> list[FileRequest]:
-    """Every request of a JSON Lines file, each checked as ``ara translate`` checks one
-    (:func:`~ara.eval.translator.check_request`); blank lines are skipped.
-
-    Raises:
-        ConfigError: If the file cannot be read, holds no request, or has bad lines;
-            the message names each (up to :data:`MAX_REPORTED`) with its line number.
-    """
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as err:
-        raise ConfigError(f"cannot read {path}: {err}") from None
-    requests, bad = [], []
-    for number, text in enumerate(lines, start=1):
-        if not text.strip():
-            continue
-        try:
-            requests.append(_request(number, text, config))
-        except AraError as err:  # a bad row, a request check, a reference that won't parse
-            bad.append(f"line {number}: {err}")
-    if bad:
-        more = len(bad) - MAX_REPORTED
-        raise ConfigError(f"{path} has {len(bad)} bad line(s), nothing was translated:\n  "
-                          + "\n  ".join(bad[:MAX_REPORTED])
-                          + (f"\n  ... and {more} more" if more > 0 else ""))
-    if not requests:
-        raise ConfigError(f"{path} holds no request: write one JSON object per line, e.g. "
-                          '{"nl": "never enter the lab", "aps": ["enter_lab"]}')
-    return requests
-
-
-def _request(number: int, text: str, config: TranslatorConfig) -> FileRequest:
-    try:
-        row = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise ConfigError(f"not JSON ({err.msg} at column {err.colno})") from None
-    if not isinstance(row, dict):
-        raise ConfigError('expected an object like {"nl": "...", "aps": ["..."]}')
-    unknown = sorted(set(row) - {"nl", "aps", "stl", "id"})
-    if unknown:
-        raise ConfigError(f"unknown key(s) {', '.join(unknown)}: a line has nl, aps and "
-                          "optionally stl (a reference) and id")
-    nl, aps = row.get("nl"), row.get("aps")
-    if not isinstance(nl, str):
-        raise ConfigError('"nl" must be the instruction, a string')
-    if isinstance(aps, str):  # "a, b" as on the command line
-        aps = [a.strip() for a in aps.split(",") if a.strip()]
-    if not isinstance(aps, list) or not aps or not all(isinstance(a, str) for a in aps):
-        raise ConfigError('"aps" must be a non-empty list of proposition names')
-    check_request(nl, aps, config)
-    reference = row.get("stl")
-    if reference is not None:
-        if not isinstance(reference, str):
-            raise ConfigError('"stl" must be a formula, a string')
-        formula = parse(reference)
-        foreign = sorted(atoms(formula) - set(aps))
-        if foreign:  # the grammar over aps could never write it
-            raise ConfigError(f'the reference names {", ".join(foreign)}, which "aps" does '
-                              "not list")
-        reference = to_text(formula)
-    ident = row.get("id")
-    return FileRequest(number, nl, tuple(aps), reference,
-                       None if ident is None else str(ident))
 
 
 def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int:
@@ -186,7 +92,7 @@ def translate_requests(translator: Translator, requests: Iterable[FileRequest], 
 
     ``shots_for(nl, aps)`` gives the worked examples for a request. A line is
     the request (``line``, ``id`` if any, ``nl``, ``aps``) and its answer's
-    :meth:`~ara.eval.answering.Answer.to_json`;
+    :meth:`~ara.eval.translate.answering.Answer.to_json`;
     with a reference, also ``reference`` and Spot's ``equivalent`` (``None``:
     undecided in ``spot_timeout_s``).
     """

@@ -6,7 +6,7 @@ A translation that never uses a listed proposition, or a number the sentence sta
 a bound, is wrong whatever else it says: "reach the dock within 250 steps" has to put
 250 somewhere. On the shipped fine-tune's held-out sets nearly every answer with a gap
 was wrong (docs/model-card.md), so a gap is a cheap, precise signal to look for another
-answer (:func:`ara.eval.consistency.translate_repaired`). The words each check reads
+answer (:func:`ara.eval.translate.repair.translate_repaired`). The words each check reads
 are :mod:`ara.grammars.cues`.
 
 The checks are one-sided on purpose: an answer with no gap can still be wrong, and a
@@ -20,7 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from ara.eval.request import Request
+from ara.eval.translate.request import Request
 from ara.grammars import Formula, atoms, parse, walk
 from ara.grammars.ast import interval_of
 from ara.grammars.literal_edits import (

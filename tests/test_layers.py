@@ -1,0 +1,77 @@
+"""Every import goes downward: a module uses its own area and the ones below it.
+
+    ara's shared modules (errors, provenance, run_store, ...)
+      <- grammars <- data <- eval/translate (the translator)
+      <- eval (the F/P/C harness), training, coordination (side by side, not each other)
+      <- ara.api, ara.cli, ara.demo (and each area's ``cli`` module, which wires commands)
+
+So the language core can be read without the data, the translator without the
+experiments, and a change to the harness cannot reach what ``ara translate`` does.
+"""
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).parents[1]
+#: Each top-level folder and the subpackage of ``ara`` it installs as.
+FOLDERS = {"ara": "ara", "grammars": "ara.grammars", "data": "ara.data", "eval": "ara.eval",
+           "training": "ara.training", "coordination": "ara.coordination"}
+#: (prefix, area, level), most specific prefix first.
+AREAS = [("ara.grammars", "grammars", 1), ("ara.data", "data", 2),
+         ("ara.eval.translate", "translate", 3), ("ara.eval", "eval", 4),
+         ("ara.training", "training", 4), ("ara.coordination", "coordination", 4),
+         ("ara.api", "product", 5), ("ara.cli", "product", 5), ("ara.demo", "product", 5)]
+
+
+def area(module: str) -> tuple[str, int]:
+    for prefix, name, level in AREAS:
+        if module == prefix or module.startswith(prefix + "."):
+            return name, level
+    return "shared", 0
+
+
+def module_name(path: Path, root: Path = ROOT) -> str:
+    folder, *rest = path.relative_to(root).with_suffix("").parts
+    return ".".join([FOLDERS[folder], *(p for p in rest if p != "__init__")])
+
+
+def imports(path: Path) -> set[str]:
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found.add(node.module)
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    return {name for name in found if name == "ara" or name.startswith("ara.")}
+
+
+def upward_imports(root: Path = ROOT) -> list[str]:
+    wrong = []
+    for folder in FOLDERS:
+        for path in sorted((root / folder).rglob("*.py")):
+            module = module_name(path, root)
+            if module.endswith(".cli"):  # commands wire every area below the product
+                continue
+            own, level = area(module)
+            for name in sorted(imports(path)):
+                other, other_level = area(name)
+                if other_level > level or (other_level == level and other != own):
+                    wrong.append(f"{module} ({own}) imports {name} ({other})")
+    return wrong
+
+
+def test_every_import_goes_downward():
+    assert not upward_imports(), "\n".join(upward_imports())
+
+
+def test_the_check_sees_an_upward_import(tmp_path):
+    for name, text in {"grammars/ast.py": "from ara.errors import AraError\n",
+                       "eval/translate/repair.py": "from ara.eval.harness import judge\n",
+                       "eval/harness.py": "from ara.eval.translate import repair\n",
+                       "training/recipe.py": "import ara.coordination.world\n",
+                       "data/cli.py": "from ara.api import translate\n"}.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    assert upward_imports(tmp_path) == [
+        "ara.eval.translate.repair (translate) imports ara.eval.harness (eval)",
+        "ara.training.recipe (training) imports ara.coordination.world (coordination)"]
