@@ -14,6 +14,7 @@ from pathlib import Path
 import yaml
 
 from ara.errors import ConfigError, did_you_mean
+from ara.eval.translate.models import SHIPPED
 
 
 def _build(cls, data: dict | None, where: str):
@@ -29,8 +30,7 @@ def _build(cls, data: dict | None, where: str):
 
 #: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
 #: by ``--model`` name, beside their GGUF.
-SHIPPED_PEFT = {"finetuned": Path(__file__).parents[1] / "eval" / "models"
-                / "gemma3-270m-nl2tl-lora-peft"}
+SHIPPED_PEFT = {"finetuned": SHIPPED / "gemma3-270m-nl2tl-lora-peft"}
 
 
 @dataclass(frozen=True)
