@@ -187,8 +187,8 @@ def translate_file_cmd(
     each as they are made, so an interrupted run loses nothing: rerun with
     --resume. At the end a summary: how many answers are valid, doubted
     (confidence below 0.5), leave part of the request out, and, for lines
-    with a reference, how many are Spot-equivalent to it. The knobs of
-    experiments on files are in `ara eval ablation --data`.
+    with a reference, how many are Spot-equivalent to it. Repair's other
+    ways (--repair-by, --doubt) are in `ara eval ablation --data`.
     """
     from dataclasses import asdict
 

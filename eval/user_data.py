@@ -1,6 +1,6 @@
 """A user's own pairs as the test side of an ablation (and, optionally, its worked examples).
 
-The files are those ``ara translate-file`` reads (:mod:`ara.eval.translate.batch`), with the
+The files are those ``ara translate-file`` reads (:mod:`ara.eval.translate.request_file`), with the
 reference ``stl`` required on every line::
 
     {"nl": "Never enter the server room.", "aps": ["enter_server_room"],

@@ -1,4 +1,5 @@
-"""Logical checks through Spot: equivalence and implication of formulas.
+"""Logical checks through Spot: equivalence and implication of formulas, and the verdicts
+on a model's answer against a reference (:func:`judge`).
 
 Spot decides LTL over infinite words. Discrete-time STL intervals map onto Spot's
 bounded operators (``F[a..b]``, ``G[a..b]``, ``X[n]``); Spot has no bounded until,

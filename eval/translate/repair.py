@@ -1,7 +1,8 @@
-"""Semantic self-consistency: several answers under the grammar, grouped by meaning.
+"""More answers than the greedy one: a self-consistency vote, and repair of an answer that
+leaves part of the request out.
 
-The greedy answer and ``samples - 1`` sampled ones (seeded, under the same grammar, so
-all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
+The vote (:func:`translate_consistent`): the greedy answer and ``samples - 1`` sampled
+ones (seeded, under the same grammar, so all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
 ``F(a | b)`` vote together. The largest group wins; a tie goes to the group holding the
 greedy answer, so with one sample this is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
