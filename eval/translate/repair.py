@@ -2,9 +2,10 @@
 leaves part of the request out.
 
 The vote (:func:`translate_consistent`): the greedy answer and ``samples - 1`` sampled
-ones (seeded, under the same grammar, so all are valid) are grouped by Spot equivalence, not by text: ``F(a) | F(b)`` and
-``F(a | b)`` vote together. The largest group wins; a tie goes to the group holding the
-greedy answer, so with one sample this is plain greedy decoding. The cost is
+ones (seeded, under the same grammar, so all are valid) are grouped by Spot
+equivalence, not by text: ``F(a) | F(b)`` and ``F(a | b)`` vote together. The largest
+group wins; a tie goes to the group holding the greedy answer, so with one sample this
+is plain greedy decoding. The cost is
 ``samples`` generations plus the Spot checks between distinct answers.
 
 Repair (:func:`translate_repaired`) looks for another answer only when the greedy one
