@@ -28,8 +28,11 @@ class Request:
     Attributes:
         nl: The sentence.
         aps: Its propositions, as listed.
+        unmentioned: The propositions it never mentions (:func:`mentions`), which a
+            request may not list.
         numbers: Every number it writes, in digits or words: the bounds its grammar
             may use (:meth:`~ara.eval.translate.translator.TranslatorConfig.syntax`).
+        digits: The numbers it writes in digits.
         stated: The numbers it states as time (:func:`stated_numbers`): the bounds an
             answer has to write.
         claims: What it asks in words to hold, happen or recur, in the order of
@@ -44,7 +47,9 @@ class Request:
 
     nl: str
     aps: tuple[str, ...]
+    unmentioned: tuple[str, ...] = ()
     numbers: frozenset[int] = frozenset()
+    digits: frozenset[int] = frozenset()
     stated: frozenset[int] = frozenset()
     claims: tuple[str, ...] = ()
     claim_words: tuple[str, ...] = ()
@@ -70,7 +75,9 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
     text, unnamed = nl.lower(), _unnamed(nl, aps)
     found = [(claim, m.group(0)) for claim, words in CLAIM_WORDS.items()
              if (m := words.search(unnamed))]
-    return Request(nl=nl, aps=aps, numbers=frozenset(written_numbers(nl)),
+    return Request(nl=nl, aps=aps, unmentioned=tuple(ap for ap in aps if not mentions(nl, ap)),
+                   numbers=frozenset(written_numbers(nl)),
+                   digits=frozenset(int(n) for n in re.findall(r"\d+", nl)),
                    stated=stated_numbers(nl, aps),
                    claims=tuple(claim for claim, _ in found),
                    claim_words=tuple(word for _, word in found),
@@ -78,6 +85,18 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
                                     if words.search(text)),
                    ordered=says_in_order(text),
                    any_order=ANY_ORDER_WORDS.search(text) is not None)
+
+
+_STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
+
+
+def mentions(nl: str, ap: str) -> bool:
+    """Whether ``nl`` mentions proposition ``ap``: its name, or a word of it (3+ letters)."""
+    text = nl.lower()
+    if re.search(rf"\b{re.escape(ap.lower())}\b", text):
+        return True
+    words = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
+    return any(w in text for w in words)
 
 
 def written_numbers(nl: str) -> set[int]:

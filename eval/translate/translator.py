@@ -9,7 +9,6 @@ complete formula, and :meth:`Syntax.check` is then asserted on it.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from functools import lru_cache
@@ -135,18 +134,6 @@ class RequestError(AraError, ValueError):
     never mentions, or with a bound the grammar cannot write)."""
 
 
-_STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
-
-
-def mentions(nl: str, ap: str) -> bool:
-    """Whether ``nl`` mentions proposition ``ap``: its name, or a word of it (3+ letters)."""
-    text = nl.lower()
-    if re.search(rf"\b{re.escape(ap.lower())}\b", text):
-        return True
-    words = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
-    return any(w in text for w in words)
-
-
 def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None:
     """Refuse a request a user most likely got wrong, saying what to change.
 
@@ -157,14 +144,14 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
     if not nl.strip():
         raise RequestError("the instruction is empty: pass the sentence to translate, e.g. "
                            "'always avoid the door'")
-    unmentioned = [ap for ap in aps if not mentions(nl, ap)]
+    request = Request.of(nl, aps)
+    unmentioned = request.unmentioned
     if unmentioned:
         raise RequestError(
             f"the instruction {nl!r} never mentions {', '.join(unmentioned)}: each proposition "
             "in --aps must be named in the sentence (by its name or a word of it, e.g. "
             "go_to_kitchen by 'kitchen'); drop the others from --aps")
-    # digits only: the grammar drops number words above its largest bound
-    numbers = [int(n) for n in re.findall(r"\d+", nl)]
+    numbers = request.digits  # the grammar drops number words above its largest bound
     if config.intervals and numbers and max(numbers) > config.max_bound:
         raise RequestError(
             f"the instruction mentions {max(numbers)}, above the grammar's largest time bound "

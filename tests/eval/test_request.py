@@ -32,6 +32,15 @@ def test_the_grammar_may_write_every_number_the_sentence_writes():
     assert written_numbers("always avoid the door") == set()
 
 
+def test_what_a_request_is_checked_for_before_translation():
+    """Tests the propositions a sentence never names (a word of 3+ letters counts), and
+    the numbers in digits, which a bound above the grammar's largest refuses."""
+    request = Request.of("Go to the kitchen, wait ten minutes or 1200 steps",
+                         ["go_to_kitchen", "open_door"])
+    assert request.unmentioned == ("open_door",)
+    assert request.digits == {1200} and request.numbers == {10, 1200}
+
+
 def test_a_then_after_a_condition_and_sooner_or_later_order_nothing():
     """Tests which sentences ask for one step after another."""
     assert not Request.of("If the door is open, then close it.", ()).ordered
