@@ -148,8 +148,8 @@ def _index(key: str, pool: tuple[Record, ...]) -> SimilarExamples:
                 index = pickle.load(f)
             if isinstance(index, SimilarExamples) and len(index.pool) == len(pool):
                 return index
-        except (OSError, pickle.UnpicklingError, EOFError, AttributeError):
-            pass  # a cache from another version or a torn write: build it again
+        except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError):
+            pass  # a cache from another version (its classes moved) or a torn write
     index = SimilarExamples(pool)
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_suffix(f".{os.getpid()}.tmp")

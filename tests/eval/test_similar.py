@@ -60,6 +60,16 @@ def test_an_index_is_built_once_per_content_and_kept_on_disk(tmp_path, monkeypat
     assert pool_hash(POOL) != pool_hash(POOL[:3]) != pool_hash(POOL[::-1])
 
 
+def test_an_index_kept_by_another_version_is_built_again(tmp_path, monkeypatch):
+    """Tests that a cache whose classes lived in a module since moved (as ara.eval.similar
+    did) is rebuilt, not an error."""
+    monkeypatch.setenv("ARA_CACHE", str(tmp_path))
+    stale = tmp_path / "similar" / f"{pool_hash(POOL[:2])}.pkl"
+    stale.parent.mkdir()
+    stale.write_bytes(b"cara.eval.similar\nSimilarExamples\n(tR.")  # protocol 0
+    assert len(index_for(POOL[:2]).pool) == 2
+
+
 def test_the_harness_gives_each_test_pair_its_own_similar_examples(paper_split):
     config = AblationConfig(split="paper", variants=("F+C", "C"), shots=(2,), reruns=1,
                             limit=6, examples_by="similar")
