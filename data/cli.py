@@ -22,8 +22,8 @@ def prepare_cmd(
         help="paper (random 4,500/3,000 rows of navi), disjoint (no lifted formula on both "
              "sides), timed (NL2TL's own train/dev), compositional (the training mixture "
              "and its held-out shapes and phrasings), handwritten, handwritten2, "
-             "handwritten3, handwritten4 (the hand-written suites, test only). Repeat "
-             "for several [default: all].",
+             "handwritten3, handwritten4, handwritten5 (the hand-written suites, test "
+             "only). Repeat for several [default: all].",
     ),
     seed: int = typer.Option(0, "--seed", help="Shuffle seed (timed ignores it)."),
     root: Path = ROOT_OPT,

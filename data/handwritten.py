@@ -10,7 +10,11 @@ misses, with the first suite's, guided which slips repair checks for;
 checks and is their blind measure; ``handwritten/suite4.yaml`` (split ``handwritten4``,
 167 entries, in domains no earlier suite covers: household robots, drones, hospital
 logistics, manufacturing cells, agriculture) was written blind on 2026-11-26, before any
-model answered it or any change it judges, and is never read to guide data or checks.
+model answered it or any change it judges, and is never read to guide data or checks;
+``handwritten/suite5.yaml`` (split ``handwritten5``, 134 entries, in domains no earlier
+suite covers: restaurant kitchens, construction sites, lab automation, ports and ships,
+planetary rovers) was written blind on 2026-11-26 by the same rules, before any model
+answered it, and is likewise never read to guide anything.
 """
 
 from __future__ import annotations
@@ -28,9 +32,10 @@ SUITE = Path(__file__).parent / "handwritten" / "suite.yaml"
 SUITE2 = Path(__file__).parent / "handwritten" / "suite2.yaml"
 SUITE3 = Path(__file__).parent / "handwritten" / "suite3.yaml"
 SUITE4 = Path(__file__).parent / "handwritten" / "suite4.yaml"
+SUITE5 = Path(__file__).parent / "handwritten" / "suite5.yaml"
 #: Each hand-written split and its file; a split's records carry its name as source.
 SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3,
-          "handwritten4": SUITE4}
+          "handwritten4": SUITE4, "handwritten5": SUITE5}
 
 
 @dataclass(frozen=True)
@@ -43,7 +48,8 @@ class SuiteEntry:
         confusions: Readings a translator could plausibly give instead (canonical).
         domain: ``lifted``, ``navigation``, ``manipulation`` or ``warehouse`` (the first
             three suites); ``lifted``, ``household``, ``drones``, ``hospital``,
-            ``manufacturing`` or ``agriculture`` (the fourth).
+            ``manufacturing`` or ``agriculture`` (the fourth); ``lifted``,
+            ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth).
     """
 
     nl: str

@@ -36,10 +36,11 @@ from ara.provenance import sha256_file
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
 SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten", "handwritten2",
-          "handwritten3", "handwritten4")
+          "handwritten3", "handwritten4", "handwritten5")
 FORMS = ("lifted", "grounded")
 #: Splits fixed by their files, whatever the seed.
-UNSEEDED = ("timed", "handwritten", "handwritten2", "handwritten3", "handwritten4")
+UNSEEDED = ("timed", "handwritten", "handwritten2", "handwritten3", "handwritten4",
+            "handwritten5")
 
 
 class DataVersionWarning(UserWarning):
@@ -119,8 +120,8 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
             formula on both sides), ``timed`` (NL2TL's own train/dev, seed unused) or
             ``compositional`` (the training mixture; test: held-out synthetic shapes
             and phrasings, see :mod:`ara.data.mixture`) or ``handwritten``,
-            ``handwritten2``, ``handwritten3`` and ``handwritten4`` (the hand-written
-            suites, test only; seed unused).
+            ``handwritten2``, ``handwritten3``, ``handwritten4`` and ``handwritten5``
+            (the hand-written suites, test only; seed unused).
         seed: Shuffle seed.
         root: Parent folder; :func:`default_root` by default.
     """

@@ -263,7 +263,8 @@ def ablation_cmd(
         help="paper (the default), disjoint, timed, compositional (held-out shapes and "
              "phrasings), handwritten (the hand-written suite), handwritten2 (the "
              "second, never read for data), handwritten3 (the third, never read at all) "
-             "or handwritten4 (the fourth, blind, in new domains)."),
+             "handwritten4 (the fourth, blind, in new domains) or handwritten5 (the "
+             "fifth, blind, in five more domains)."),
     data: Path | None = typer.Option(
         None, "--data", dir_okay=False,
         help="Your own pairs instead of a split: JSON Lines as `ara translate-file` reads, "

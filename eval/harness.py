@@ -83,7 +83,8 @@ class AblationConfig:
 
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
-            ``handwritten``, ``handwritten2``, ``handwritten3``, ``handwritten4``), or
+            ``handwritten``, ``handwritten2``, ``handwritten3``, ``handwritten4``,
+            ``handwritten5``), or
             ``file``: the pairs of ``data``.
         form: ``lifted`` or ``grounded`` records; for ``file``, None (every line) or
             the lines of that form.

@@ -130,6 +130,7 @@ SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
         ("handwritten2", "lifted"), ("handwritten2", "grounded"),
         ("handwritten3", "lifted"), ("handwritten3", "grounded"),
         ("handwritten4", "lifted"), ("handwritten4", "grounded"),
+        ("handwritten5", "lifted"), ("handwritten5", "grounded"),
         ("compositional", "lifted"), ("compositional", "grounded"),
         ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
 VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]

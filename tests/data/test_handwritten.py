@@ -6,7 +6,16 @@ import re
 
 import pytest
 
-from ara.data.handwritten import SUITE, SUITE2, SUITE3, SUITE4, SUITES, load_suite, suite_records
+from ara.data.handwritten import (
+    SUITE,
+    SUITE2,
+    SUITE3,
+    SUITE4,
+    SUITE5,
+    SUITES,
+    load_suite,
+    suite_records,
+)
 from ara.data.normalize import read_raw
 from ara.data.store import RAW_DIR
 from ara.grammars import parse
@@ -14,13 +23,15 @@ from ara.grammars.spot_bridge import equivalent
 
 #: The least each suite holds: entries, and entries with a time bound.
 SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15),
-         "handwritten4": (150, 60)}
-#: Each suite's domains: the fourth's grounded ones are ones no earlier suite covers.
+         "handwritten4": (150, 60), "handwritten5": (120, 40)}
+#: Each suite's domains: the fourth's and fifth's grounded ones are ones no earlier suite
+#: covers.
 FIRST_DOMAINS = {"lifted", "navigation", "manipulation", "warehouse"}
 DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
            "handwritten3": FIRST_DOMAINS,
            "handwritten4": {"lifted", "household", "drones", "hospital", "manufacturing",
-                            "agriculture"}}
+                            "agriculture"},
+           "handwritten5": {"lifted", "restaurant", "construction", "lab", "port", "rover"}}
 
 
 @pytest.fixture(scope="module", params=sorted(SUITES))
@@ -72,6 +83,8 @@ def test_each_suite_repeats_no_sentence_of_an_earlier_one():
     assert [e.nl for e in load_suite(SUITE3) if _norm(e.nl) in earlier] == []
     earlier |= {_norm(e.nl) for e in load_suite(SUITE3)}
     assert [e.nl for e in load_suite(SUITE4) if _norm(e.nl) in earlier] == []
+    earlier |= {_norm(e.nl) for e in load_suite(SUITE4)}
+    assert [e.nl for e in load_suite(SUITE5) if _norm(e.nl) in earlier] == []
 
 
 @pytest.mark.parametrize("split", sorted(SUITES))
