@@ -76,8 +76,7 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
     found = [(claim, m.group(0)) for claim, words in CLAIM_WORDS.items()
              if (m := words.search(unnamed))]
     return Request(nl=nl, aps=aps, unmentioned=tuple(ap for ap in aps if not mentions(nl, ap)),
-                   numbers=frozenset(written_numbers(nl)),
-                   digits=frozenset(int(n) for n in re.findall(r"\d+", nl)),
+                   numbers=frozenset(written_numbers(nl)), digits=digits_of(nl),
                    stated=stated_numbers(nl, aps),
                    claims=tuple(claim for claim, _ in found),
                    claim_words=tuple(word for _, word in found),
@@ -99,11 +98,15 @@ def mentions(nl: str, ap: str) -> bool:
     return any(w in text for w in words)
 
 
+def digits_of(nl: str) -> frozenset[int]:
+    """The numbers ``nl`` writes in digits."""
+    return frozenset(int(n) for n in re.findall(r"\d+", nl))
+
+
 def written_numbers(nl: str) -> set[int]:
     """The numbers ``nl`` writes, as digits or as words ("ten", "thirty")."""
     words = re.findall(r"[a-z]+", nl.lower())
-    return {int(n) for n in re.findall(r"\d+", nl)} | {NUMBER_WORDS[w] for w in words
-                                                       if w in NUMBER_WORDS}
+    return set(digits_of(nl)) | {NUMBER_WORDS[w] for w in words if w in NUMBER_WORDS}
 
 
 def stated_numbers(nl: str, aps: Sequence[str]) -> frozenset[int]:
