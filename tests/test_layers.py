@@ -1,4 +1,5 @@
-"""Every import goes downward: a module uses its own area and the ones below it.
+"""The package's layout: every import goes downward (a module uses its own area and the
+ones below it), and a wheel installs every folder of modules.
 
     ara's shared modules (errors, provenance, run_store, ...)
       <- grammars <- data <- eval/translate (the translator)
@@ -12,10 +13,15 @@ experiments, and a change to the harness cannot reach what ``ara translate`` doe
 import ast
 from pathlib import Path
 
+import pytest
+
+tomllib = pytest.importorskip("tomllib", reason="reads pyproject.toml with Python 3.11's tomllib")
+
 ROOT = Path(__file__).parents[1]
+#: What setuptools installs: ``packages`` and the folder of each (``package-dir``).
+SETUPTOOLS = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
 #: Each top-level folder and the subpackage of ``ara`` it installs as.
-FOLDERS = {"ara": "ara", "grammars": "ara.grammars", "data": "ara.data", "eval": "ara.eval",
-           "training": "ara.training", "coordination": "ara.coordination"}
+FOLDERS = {folder: package for package, folder in SETUPTOOLS["package-dir"].items()}
 #: (prefix, area, level), most specific prefix first.
 AREAS = [("ara.grammars", "grammars", 1), ("ara.data", "data", 2),
          ("ara.eval.translate", "translate", 3), ("ara.eval", "eval", 4),
@@ -63,7 +69,7 @@ def upward_imports(root: Path = ROOT) -> list[str]:
                 other, other_level = area(name)
                 if other_level > level or (other_level == level and other != own):
                     wrong.append(f"{module} ({own}) imports {name} ({other})")
-    return wrong
+    return sorted(wrong)
 
 
 def test_every_import_goes_downward():
@@ -83,3 +89,15 @@ def test_the_check_sees_an_upward_import(tmp_path):
         "ara.data.store (data) imports ara.demo (product)",
         "ara.eval.translate.repair (translate) imports ara.eval.harness (eval)",
         "ara.training.recipe (training) imports ara.coordination.world (coordination)"]
+
+
+def test_a_wheel_installs_every_python_folder():
+    """setuptools installs only the packages pyproject lists: a folder of modules left
+    out imports in a checkout (editable) and is missing from a wheel."""
+    listed, needed = set(SETUPTOOLS["packages"]), set()
+    for package, folder in SETUPTOOLS["package-dir"].items():
+        for init in (ROOT / folder).rglob("*.py"):
+            inside = init.parent.relative_to(ROOT / folder).parts
+            if "prepared" not in inside and not inside[:1] == ("models",):
+                needed.add(".".join([package, *inside]))
+    assert needed <= listed, f"add to [tool.setuptools] packages: {sorted(needed - listed)}"

@@ -62,18 +62,3 @@ def test_training_configs_are_few_and_read_nothing_from_docs():
     assert 1 <= len(configs) <= 6, [c.name for c in configs]
     assert not [c.name for c in configs if "docs/" in c.read_text()]
 
-
-def test_a_wheel_installs_every_python_folder():
-    """setuptools installs only the packages pyproject lists: a folder of modules left
-    out imports in a checkout (editable) and is missing from a wheel."""
-    import tomllib
-
-    tool = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
-    listed, folders = set(tool["packages"]), tool["package-dir"]
-    needed = set()
-    for package, folder in folders.items():
-        for init in (ROOT / folder).rglob("*.py"):
-            inside = init.parent.relative_to(ROOT / folder).parts
-            if "prepared" not in inside and not inside[:1] == ("models",):
-                needed.add(".".join([package, *inside]))
-    assert needed <= listed, f"add to [tool.setuptools] packages: {sorted(needed - listed)}"
