@@ -57,6 +57,11 @@ def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int
     return len(rows)
 
 
+#: Settings that earlier releases' translate-file took options for and this one fixes
+#: (``ara eval ablation --data`` varies them).
+NO_OPTION = frozenset({"answer.repair.by", "answer.repair.doubt", "answer.repair.temperature"})
+
+
 def settings_path(out: Path) -> Path:
     """Where the settings of the run that writes ``out`` are kept: ``answers.jsonl`` ->
     ``answers.settings.json``, so that ``out`` stays one answer per line."""
@@ -78,10 +83,12 @@ def same_settings(out: Path, settings: dict) -> None:
                             json.loads(json.dumps(settings)))  # tuples as the lists saved
         if changed:
             name, (before, after) = next(iter(changed.items()))
+            fix = ("translate-file no longer takes an option for it: finish the output with "
+                   "the release that made it" if name in NO_OPTION else
+                   "pass the options it was made with to resume it")
             raise ConfigError(
                 f"{out} was made with {name} = {json.dumps(before)}, this run has "
-                f"{json.dumps(after)} ({path}): pass the options it was made with "
-                "to resume it, or choose another --out")
+                f"{json.dumps(after)} ({path}): {fix}, or choose another --out")
 
 
 def translate_requests(translator: Translator, requests: Iterable[FileRequest], out: Path,

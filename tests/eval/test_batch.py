@@ -104,6 +104,9 @@ def test_resume_refuses_an_output_made_with_other_settings(tmp_path):
                                           r"= null, this run has 0 .*pass the options it "
                                           "was made with"):
         same_settings(out, other)
+    doubted = {**settings, "answer": {"repair": {"samples": None, "by": "samples"}}}
+    with pytest.raises(ConfigError, match="answer.repair.by .*no longer takes an option"):
+        same_settings(out, doubted)  # made by a release whose translate-file had --repair-by
     settings_path(out).unlink()
     same_settings(out, other)  # an output from before settings were kept
     assert not settings_path(out).exists()
