@@ -52,7 +52,11 @@ words sound negative ("the lights are off", "the tank is empty"), so that a name
 Version 3.6 stops holding out the patterns' own shapes (see :func:`pattern_shapes`:
 the hash had taken the two-step sequence and the bounded response out of training),
 and adds a step with a deadline after the one before (``F(a & F[0,n](b))``) and a last
-step that is somewhere for good (``F(a & F(G(b)))``).
+step that is somewhere for good (``F(a & F(G(b)))``). Version 3.7 (after the fourth
+hand-written suite's misses) draws a recurrence with a longest gap (``G(F[0,n](a))``, "at
+least once every 6 hours") and what holds unless a condition does (``G(!a -> b)``, "keep
+the gate closed unless a truck is waiting"), and says a window as "no sooner than 4 and
+no later than 9".
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators, other than
@@ -95,7 +99,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.6.0"
+SYNTHETIC_VERSION = "3.7.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -187,6 +191,10 @@ def _pattern_builders(rng: random.Random, iv: Interval | None, deadline: Interva
         # somewhere for good ("then go to the dock and stay there")
         lambda: Eventually(And((a, Eventually(b, deadline)))),
         lambda: Eventually(And((a, Eventually(Always(b))))),
+        # 3.7: a recurrence with a longest gap ("at least once every 24 hours") and what
+        # holds unless a condition does ("keep the vacuum docked unless the house is
+        # empty"), which the fourth hand-written suite asked for and no version said
+        lambda: Always(Eventually(a, deadline)), lambda: Always(Implies(Not(a), b)),
     ]
 
 

@@ -6,7 +6,8 @@ the unit, propositions by name. ``realize(formula, rng, ...)`` draws a phrasing 
 construct, a time unit and a sentence layout, so one formula becomes many sentences.
 
 Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
-often", ``G(a -> F(b))`` "whenever a, eventually b", ``F(a & F(b))`` "first a, then b",
+often", ``G(a -> F(b))`` "whenever a, eventually b", ``G(F[0,n](a))`` "a at least once
+every n steps", ``G(!a -> b)`` "b unless a", ``F(a & F(b))`` "first a, then b",
 ``F(a & F[0,n](b))`` "a, and within n steps after that, b", ``!a U b`` "do not a until
 b", ``F(a & G(b))`` "eventually a, and from then on always b", ``(a | b) & !(a & b)`` "a
 or b, but not both"; in sampled sentences also ``F(a) & F(b)`` "a and b, in any order",
@@ -66,7 +67,9 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "after {lo} {u} but no later than {hi} {u}, {a}",
              "at some time in the window from {lo} to {hi} {u}, {a}",
              "between {s} {lo} and {s} {hi}, {a} at least once",
-             "{a} at least once between {lo} and {hi} {u} from now"),
+             "{a} at least once between {lo} and {hi} {u} from now",
+             "no sooner than {s} {lo} and no later than {s} {hi}, {a}",
+             "{a} no earlier than {lo} {u} and no later than {hi} {u} from now"),
     "G": ("always {a}", "{a} at all times", "at every step, {a}", "{a} forever",
           "it is always the case that {a}", "globally {a}", "{a} all the time",
           "constantly {a}", "{a} the whole time"),
@@ -77,7 +80,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "throughout the window from {lo} to {hi} {u}, {a}",
              "{a} all the time from {lo} to {hi} {u}",
              "for each time instant in the next {lo} to {hi} {u}, {a}",
-             "between {s} {lo} and {s} {hi}, {a} the whole time"),
+             "between {s} {lo} and {s} {hi}, {a} the whole time",
+             "{a} from {s} {lo} through {s} {hi}"),
     "never": ("never {a}", "at no time {a}", "{a} must never happen", "must not ever {a}",
               "always avoid {a}", "avoid {a} at all times", "it must never be the case that {a}",
               "under no circumstances {a}", "{a} is never allowed"),
@@ -97,6 +101,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "GF": ("{a} infinitely often", "{a} over and over again", "repeatedly {a}",
            "always eventually {a}", "{a} again and again", "keep returning to {a} forever",
            "{a} periodically", "regularly {a}", "{a} time and again"),
+    # G(F[0,n](a)): a recurrence with a longest gap.
+    "GF_n": ("{a} at least once every {n} {u}", "at least once every {n} {u}, {a}",
+             "{a} at least every {n} {u}", "{a} regularly, at most {n} {u} apart",
+             "{a} every {n} {u} or more often"),
     "GF_place": ("keep coming back to {x}", "return to {x} again and again",
                  "keep visiting {x} forever", "visit {x} over and over",
                  "go back to {x} infinitely often"),
@@ -129,6 +137,10 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "invariant_not": ("never {b} while {a}", "do not {b} while {a}", "never {b} when {a}",
                       "you must not {b} while {a}", "{b} is not allowed while {a}",
                       "whenever {a}, never {b}"),
+    # G(!a -> b): what holds except while a condition does.
+    "unless": ("{b} unless {a}", "always {b} unless {a}", "unless {a}, {b}",
+               "{b} at all times, except while {a}", "at all times, {b} unless {a}",
+               "{b}, except when {a}"),
     "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
                   "at all times, if {a} then {b}", "always, if {a}, then {b}",
                   "while {a}, {b}", "{b} while {a}", "as long as {a}, {b}",
@@ -197,6 +209,8 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "never_n": frozenset({"{a} must not happen within {n} {u}"}),
     "FG": frozenset({"{a} from some point on, forever"}),
     "GF": frozenset({"keep returning to {a} forever"}),
+    "GF_n": frozenset({"{a} every {n} {u} or more often"}),
+    "unless": frozenset({"{b}, except when {a}"}),
     "response": frozenset({"any time {a}, sooner or later {b}"}),
     "response_do": frozenset({"{b} every time {a}"}),
     "response_n": frozenset({"whenever {a}, within {n} {u} {b}"}),
@@ -446,6 +460,11 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         if negated is not None:  # "always stay out of the kitchen"
             return _timed("G", f.interval, r, used, a=negated)
         return _timed("never", f.interval, r, used, a=sub(f.arg.arg))
+    gap = _untimed(f, Always)
+    if isinstance(gap, Eventually) and gap.interval is not None and gap.interval.lo == 0 \
+            and gap.interval.hi is not None:
+        # "at least once every 6 steps"
+        return r.pick("GF_n", used, a=sub(gap.arg), n=gap.interval.hi)
     for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
         inner = _untimed(f, outer)
         if inner is not None and _untimed(inner, nested) is not None:
@@ -480,6 +499,10 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             if rhs.interval is None:
                 return r.pick("response", used, a=sub(lhs), b=sub(rhs.arg))
             return r.pick("response_n", used, a=sub(lhs), b=sub(rhs.arg), n=rhs.interval.hi)
+        if isinstance(lhs, Not) and isinstance(lhs.arg, Atom) and (isinstance(rhs, Atom) or (
+                isinstance(rhs, (And, Or)) and all(_is_literal(g) for g in rhs.args))):
+            # "keep the vacuum docked unless the house is empty"
+            return r.pick("unless", used, a=sub(lhs.arg), b=sub(rhs))
         said = _negated(rhs, r) if isinstance(rhs, Not) else None
         if said is None and isinstance(rhs, Not) and isinstance(rhs.arg, Atom) \
                 and r.is_action(rhs.arg.name) and r.rng is not None and r.rng.random() < 0.5:

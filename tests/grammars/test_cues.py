@@ -35,9 +35,12 @@ KNOWN_MISSES = {
     ("happens at some point", "{a} between {lo} and {hi} {u} from now"),
     ("happens at some point", "within {lo} to {hi} {u}, {a}"),
     ("happens at some point", "after {lo} {u} but no later than {hi} {u}, {a}"),
+    ("happens at some point",
+     "{a} no earlier than {lo} {u} and no later than {hi} {u} from now"),
     # "during", "within" and "from ... to" may bound an F as well.
     ("holds over time", "during the first {n} {u}, {a}"),
     ("holds over time", "from {s} {lo} to {s} {hi}, {a}"),
+    ("holds over time", "{a} from {s} {lo} through {s} {hi}"),
     ("holds over time", "do not {a} during the first {n} {u}"),
     ("holds over time", "{a} must not happen within {n} {u}"),
     # Not among the words that ask for a G; adding them changes which answers repair acts

@@ -36,6 +36,10 @@ from conftest import formulas
         ("F(pick & F(place)) & G(!obstacle)", "first pick, then place, and never obstacle"),
         ("F(a & G(b))", "eventually a, and from then on always b"),
         ("(a | b) & !(a & b)", "a or b, but not both"),
+        # a recurrence with a longest gap, and what holds unless a condition does
+        ("G(F[0,6](a))", "a at least once every 6 steps"),
+        ("G(!a -> b)", "b unless a"),
+        ("G(!a -> F(b))", "whenever not a, eventually b"),  # a response, not "unless"
         ("(F(a) | F(b)) & !(F(a) & F(b))", "eventually a or eventually b, but not both"),
     ],
 )
