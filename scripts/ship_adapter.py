@@ -5,8 +5,9 @@
         --name gemma3-270m-nl2tl-paper-lora.gguf --split paper
 
 EXPORT is the recipe's export stage, or a run folder that `ara export --lora-gguf` wrote
-into (its `export/`). The adapter is copied into `eval/models/NAME` beside a record of
-what produced it (the run, the export with its parity, the held-out check) and the parity
+into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT into
+`NAME-peft/`, which `init_adapter: finetuned` reads) beside a record of what produced it
+(the run, the export with its parity, the held-out check) and the parity
 of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
 merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
 `--min-agreement` nothing is shipped. Compare the candidate on the blind sets
@@ -23,13 +24,16 @@ from pathlib import Path
 
 from ara.errors import ConfigError
 
+#: What a PEFT adapter folder needs, of what a run's ``adapter/`` holds.
+PEFT_FILES = ("adapter_config.json", "adapter_model.safetensors")
+
 
 def export_folders(path: Path) -> tuple[Path, Path]:
     """(the training run's record folder, the export folder) of ``path``."""
     export = path / "export" if (path / "export" / "lora.gguf").is_file() else path
     run = path if (path / "run.json").is_file() else export
     for need in (export / "lora.gguf", export / "export.json", export / "merged-hf",
-                 run / "run.json"):
+                 run / "run.json", *(run / "adapter" / part for part in PEFT_FILES)):
         if not need.exists():
             raise ConfigError(f"{path}: no {need.name}; export the run first "
                               "(`ara export --run RUN --quant f16 --lora-gguf`)")
@@ -54,6 +58,12 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
                           f"{min_agreement:.0%}: not shipped")
     target = SHIPPED / name
     shutil.copyfile(export / "lora.gguf", target)
+    # The same weights as PEFT, which a warm start from the shipped file reads
+    # (`init_adapter: finetuned`): the two must never come from different runs.
+    peft = SHIPPED / f"{target.stem}-peft"
+    peft.mkdir(exist_ok=True)
+    for part in PEFT_FILES:
+        shutil.copyfile(run / "adapter" / part, peft / part)
     heldout = run / "heldout.json"
     manifest = {"file": name, "sha256": sha256_file(target),
                 "run": json.loads((run / "run.json").read_text()),
