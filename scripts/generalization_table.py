@@ -123,7 +123,11 @@ MODELS = {
     "soup-v11v12-270m": ("soup v11+v12 (shipped until 2026-11-24)",
                          ("compositional", "690d5d4a1e5f")),
     "v16-shipped-270m": ("v16 (shipped until 2026-11-24)", ("compositional", "89be643cc979")),
-    "compositional-adapter-270m": ("soup v16+v17 (shipped)",
+    "shipped-greedy": ("soup v16+v17 and its 3.7 warm start (shipped 2026-11-26)",
+                       ("compositional", "f7eb90893a26")),
+    "shipped-repair8": ("the same, as ara translate (2026-11-26)",
+                        ("compositional", "f7eb90893a26")),
+    "compositional-adapter-270m": ("soup v16+v17 (shipped until 2026-11-26)",
                                    ("compositional", "89be643cc979")),
 }
 SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),

@@ -77,13 +77,14 @@ def test_overhead_pairs_each_constrained_variant_with_its_twin():
 
 def test_gap_precision_counts_flagged_references_and_right_or_wrong_answers():
     """Tests gap precision on the hand-written suite's references, which no check flags,
-    on a stored run's answers, of which three are flagged and all wrong, and on a
-    reference flagged, which counts as a right answer repair would act on."""
+    on the shipped model's stored answers to it, of which four are flagged and all wrong,
+    and on a reference flagged, which counts as a right answer repair would act on."""
     assert not any(gap_precision(suite_records("handwritten")).values())
-    run = RESULTS / "generalization/hw4-greedy/handwritten4-lifted/samples.jsonl"
+    run = RESULTS / "generalization/shipped-greedy/handwritten-lifted/samples.jsonl"
     answers = [json.loads(line) for line in run.read_text().splitlines()]
     counts = gap_precision(answers=answers)
-    assert counts["claims"] == {"wrong": 2} and counts["numbers"] == {"wrong": 1}
-    assert not counts["aps"] + counts["unasked"] + counts["order"]
+    assert counts["aps"] == {"wrong": 1} and counts["numbers"] == {"wrong": 1}
+    assert counts["unasked"] == {"wrong": 2}
+    assert not counts["order"] + counts["claims"]
     stay = SimpleNamespace(nl="Go to the dock and stay there.", aps=["at_dock"], stl="F(at_dock)")
     assert gap_precision([stay])["claims"] == {"references": 1}
