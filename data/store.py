@@ -35,12 +35,10 @@ from ara.provenance import sha256_file
 
 RAW_DIR = Path(__file__).parent / "raw" / "nl2tl"
 REGISTRY = Path(__file__).parent / "versions.json"
-SPLITS = ("paper", "disjoint", "timed", "compositional", "handwritten", "handwritten2",
-          "handwritten3", "handwritten4", "handwritten5")
+SPLITS = ("paper", "disjoint", "timed", "compositional", *SUITES)
 FORMS = ("lifted", "grounded")
 #: Splits fixed by their files, whatever the seed.
-UNSEEDED = ("timed", "handwritten", "handwritten2", "handwritten3", "handwritten4",
-            "handwritten5")
+UNSEEDED = ("timed", *SUITES)
 
 
 class DataVersionWarning(UserWarning):
