@@ -38,6 +38,10 @@ from ara.errors import ConfigError, did_you_mean
 from ara.training.config import TrainConfig
 
 KINDS = ("train", "soup", "export")
+#: Training settings that leave the adapter as it is, and so are not part of a stage's
+#: identity: a stage trained with the held-out check off (say, on a GPU box without Spot)
+#: counts as done where the check is on.
+BOOKKEEPING = frozenset({"eval_pairs", "checkpoint_every", "keep_checkpoints"})
 
 
 @dataclass(frozen=True)
@@ -134,8 +138,10 @@ class StagedRecipe:
         """Each stage's identity: its kind, settings and its inputs' fingerprints."""
         prints: dict[str, str] = {}
         for stage in self.stages:
-            settings = (self.train_config(stage).to_dict() if stage.kind == "train"
-                        else stage.settings)
+            settings = stage.settings
+            if stage.kind == "train":
+                settings = {k: v for k, v in self.train_config(stage).to_dict().items()
+                            if k not in BOOKKEEPING}
             blob = json.dumps({"kind": stage.kind, "settings": settings,
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)

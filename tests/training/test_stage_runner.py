@@ -56,6 +56,23 @@ def test_the_shipped_recipe_reads_the_base_model_and_registered_data_alone():
     assert recipe.stages[-1].kind == "export" and recipe.stages[-1].inputs == ("soup",)
 
 
+def test_a_stage_is_what_makes_its_adapter_so_bookkeeping_and_later_stages_leave_it_done():
+    """Tests that the held-out check, checkpointing and the stages after a stage do not
+    change its fingerprint, so stages trained on a GPU box with the check off and without
+    the export count as done on a machine that runs the rest; a training setting does."""
+    data = yaml.safe_load(SHIPPED_RECIPE.read_text())
+    prints = StagedRecipe.from_dict(data).fingerprints()
+    elsewhere = {**data, "defaults": {**data["defaults"], "eval_pairs": 0,
+                                      "checkpoint_every": 10},
+                 "stages": data["stages"][:-1]}
+    assert StagedRecipe.from_dict(elsewhere).fingerprints() == {
+        name: value for name, value in prints.items() if name != "export"}
+    retuned = {**data, "stages": [{**data["stages"][0], "train": {
+        **data["stages"][0]["train"], "max_steps": 941}}, *data["stages"][1:]]}
+    assert all(a != b for a, b in zip(StagedRecipe.from_dict(retuned).fingerprints().values(),
+                                      prints.values(), strict=True))
+
+
 @pytest.mark.parametrize("stages, message", [
     ([{"name": "a", "train": {}, "from": "b"}, {"name": "b", "train": {}}],
      "reads 'b', which is not a stage before it"),
