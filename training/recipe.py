@@ -102,11 +102,14 @@ class LoRAFinetuneRecipe:
         return self.config.base_model
 
     def _load_data(self):
-        from ara.data import load_split
+        from ara.data import load_or_prepare, load_split
         from ara.provenance import sha256_file
 
         data = self.config.data
-        split = load_split(data.split, data.seed, version=data.version)
+        # The registered version is deterministic: a fresh clone prepares it rather than
+        # stopping one command short of training; a pinned older one must exist.
+        split = (load_or_prepare(data.split, data.seed) if data.version is None
+                 else load_split(data.split, data.seed, version=data.version))
         if self.resume and self.out.joinpath("run.json").exists():
             started = json.loads(self.out.joinpath("run.json").read_text())["data"]["version"]
             if started != split.version:
