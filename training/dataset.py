@@ -140,29 +140,40 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
 
     Gemma's output layer (262k x hidden) costs more than the rest of a 270M model; the
     logits at position t predict token t+1, so only the positions right before an
-    answer token are kept (``logits_to_keep`` with those indices).
+    answer token go through it. ``logits_to_keep`` keeps columns for every row alike,
+    and right-padded answers sit in different columns (their union is several times
+    the answer tokens), so a hook on the output layer passes it each row's own answer
+    positions alone; the model's own forward still runs, so wrappers (peft, DDP) see it.
 
     Every prompt starts with the same instructions, about half of a training sequence.
     With ``share_prefix`` that common prefix runs once, for one row, and its keys and
     values are repeated across the batch: the same loss and the same gradients (the
     repeat sums them back), at about half the compute.
     """
-    labels = batch["labels"]
-    targets = labels[:, 1:]
-    keep = (targets != IGNORE).any(dim=0).nonzero().squeeze(1)
-    gathered = targets[:, keep]
+    targets = batch["labels"][:, 1:]
+    answered = targets != IGNORE
+    keep = answered.any(dim=0).nonzero().squeeze(1)
+    rows, cols = answered.nonzero(as_tuple=True)
+    gathered = targets[rows, cols]
+    # Where each answer position sits among the kept columns.
+    picked = torch.searchsorted(keep, cols)
     ids, mask = batch["input_ids"], batch["attention_mask"]
     shared = min(shared_prefix_length(batch), int(keep.min())) if share_prefix else 0
     if shared < 2 or ids.shape[0] == 1:
-        out = model(input_ids=ids, attention_mask=mask, logits_to_keep=keep)
+        inputs = {"input_ids": ids, "attention_mask": mask, "logits_to_keep": keep}
     else:
         prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
         cache = cache_of(prefix)
         cache.batch_repeat_interleave(ids.shape[0])
-        out = model(input_ids=ids[:, shared:], attention_mask=mask, **with_cache(cache),
-                    logits_to_keep=keep - shared)
-    logits = out.logits  # (batch, len(keep), vocab)
-    total = torch.nn.functional.cross_entropy(
-        logits.float().reshape(-1, logits.shape[-1]), gathered.reshape(-1), ignore_index=IGNORE,
-        reduction="sum")
-    return total, int((gathered != IGNORE).sum())
+        inputs = {"input_ids": ids[:, shared:], "attention_mask": mask,
+                  **with_cache(cache), "logits_to_keep": keep - shared}
+    head = getattr(model, "module", model).get_output_embeddings()
+    hook = head.register_forward_pre_hook(
+        lambda _, args: (args[0][rows, picked].unsqueeze(0), *args[1:]))
+    try:
+        out = model(**inputs)
+    finally:
+        hook.remove()
+    logits = out.logits[0]  # (answer tokens, vocab)
+    total = torch.nn.functional.cross_entropy(logits.float(), gathered, reduction="sum")
+    return total, int(gathered.numel())

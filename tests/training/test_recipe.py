@@ -151,9 +151,10 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
 
 
 @pytest.mark.slow  # a speed-up's equivalence; the golden losses pin training in the default tier
-def test_sharing_the_prompt_prefix_gives_the_same_loss_and_gradients(tiny_gemma_dir):
-    """The instructions every prompt starts with run once per batch; loss and LoRA
-    gradients must match a plain forward over the whole batch."""
+def test_the_answer_only_loss_equals_the_loss_over_every_position(tiny_gemma_dir):
+    """The instructions every prompt starts with run once per batch, and the output layer
+    sees only answer positions; loss and LoRA gradients must match a plain forward
+    that computes every position's logits."""
     import torch
     from peft import LoraConfig, get_peft_model
     from transformers import AutoModelForCausalLM, AutoTokenizer
@@ -176,11 +177,23 @@ def test_sharing_the_prompt_prefix_gives_the_same_loss_and_gradients(tiny_gemma_
         loss.backward()
         return loss.item(), [p.grad.clone() for p in model.parameters() if p.requires_grad]
 
-    plain_loss, plain_grads = loss_and_grads(False)
-    shared_loss, shared_grads = loss_and_grads(True)
-    assert shared_loss == pytest.approx(plain_loss, rel=1e-5)
-    for a, b in zip(plain_grads, shared_grads, strict=True):
-        torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-6)
+    def reference():
+        """Every position's logits, the answer tokens' cross-entropy averaged."""
+        model.zero_grad()
+        logits = model(input_ids=batch["input_ids"],
+                       attention_mask=batch["attention_mask"]).logits[:, :-1]
+        loss = torch.nn.functional.cross_entropy(
+            logits.float().reshape(-1, logits.shape[-1]),
+            batch["labels"][:, 1:].reshape(-1), ignore_index=-100)
+        loss.backward()
+        return loss.item(), [p.grad.clone() for p in model.parameters() if p.requires_grad]
+
+    full_loss, full_grads = reference()
+    for share in (False, True):
+        loss, grads = loss_and_grads(share)
+        assert loss == pytest.approx(full_loss, rel=1e-5)
+        for a, b in zip(full_grads, grads, strict=True):
+            torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-6)
 
 
 def test_two_steps_reproduce_the_golden_losses(tiny_gemma_dir, tmp_path):
