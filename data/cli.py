@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import emit, user_errors
+from ara.data.handwritten import SUITES
 from ara.data.store import SPLITS, load_or_prepare, load_split, prepare, to_hf
 
 data_app = typer.Typer(help="Prepare, inspect and export the versioned NL2TL splits.",
@@ -21,9 +22,8 @@ def prepare_cmd(
         list(SPLITS), "--split",
         help="paper (random 4,500/3,000 rows of navi), disjoint (no lifted formula on both "
              "sides), timed (NL2TL's own train/dev), compositional (the training mixture "
-             "and its held-out shapes and phrasings), handwritten, handwritten2, "
-             "handwritten3, handwritten4, handwritten5 (the hand-written suites, test "
-             "only). Repeat for several [default: all].",
+             f"and its held-out shapes and phrasings), {', '.join(SUITES)} (the "
+             "hand-written suites, test only). Repeat for several [default: all].",
     ),
     seed: int = typer.Option(0, "--seed", help="Shuffle seed (timed ignores it)."),
     root: Path = ROOT_OPT,

@@ -117,9 +117,8 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
         split: ``paper`` (random 4,500/3,000 rows of navi), ``disjoint`` (no lifted
             formula on both sides), ``timed`` (NL2TL's own train/dev, seed unused) or
             ``compositional`` (the training mixture; test: held-out synthetic shapes
-            and phrasings, see :mod:`ara.data.mixture`) or ``handwritten``,
-            ``handwritten2``, ``handwritten3``, ``handwritten4`` and ``handwritten5``
-            (the hand-written suites, test only; seed unused).
+            and phrasings, see :mod:`ara.data.mixture`) or a hand-written suite of
+            :data:`ara.data.handwritten.SUITES` (test only; seed unused).
         seed: Shuffle seed.
         root: Parent folder; :func:`default_root` by default.
     """

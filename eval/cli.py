@@ -9,6 +9,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import emit, split_list, user_errors
+from ara.data.handwritten import SUITES
 from ara.errors import ConfigError
 from ara.eval.translate.answering import BUDGET_S
 from ara.eval.translate.confidence import DOUBT
@@ -261,10 +262,8 @@ def ablation_cmd(
     split: str | None = typer.Option(
         None, "--split",
         help="paper (the default), disjoint, timed, compositional (held-out shapes and "
-             "phrasings), handwritten (the hand-written suite), handwritten2 (the "
-             "second, never read for data), handwritten3 (the third, never read at all) "
-             "handwritten4 (the fourth, blind, in new domains) or handwritten5 (the "
-             "fifth, blind, in five more domains)."),
+             f"phrasings) or a hand-written suite ({', '.join(SUITES)}; docs/data.md "
+             "says which were read to guide what)."),
     data: Path | None = typer.Option(
         None, "--data", dir_okay=False,
         help="Your own pairs instead of a split: JSON Lines as `ara translate-file` reads, "

@@ -83,8 +83,7 @@ class AblationConfig:
 
     Args:
         split: Prepared split (``paper``, ``disjoint``, ``timed``, ``compositional``,
-            ``handwritten``, ``handwritten2``, ``handwritten3``, ``handwritten4``,
-            ``handwritten5``), or
+            or a hand-written suite of :data:`ara.data.handwritten.SUITES`), or
             ``file``: the pairs of ``data``.
         form: ``lifted`` or ``grounded`` records; for ``file``, None (every line) or
             the lines of that form.

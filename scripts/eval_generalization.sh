@@ -5,11 +5,8 @@
 #
 # MODEL is an `ara --model` value (finetuned, finetuned-paper, default, lora:FILE.gguf);
 # NAME names the results folder runs/generalization/NAME/<set>-<form>/. SETs
-# (default: all): handwritten (the hand-written suite, all 164), handwritten2 (the second
-# suite, all 109, never read to guide data), handwritten3 (the third, all 65, written
-# after repair's word checks and never read to guide anything), handwritten4 (the fourth,
-# all 167, written blind in five new domains), handwritten5 (the fifth, all 134, written
-# blind in five more new domains), compositional (held-out
+# (default: all): each hand-written suite of ara.data.handwritten.SUITES (all of its
+# entries; docs/data.md says which were read to guide what), compositional (held-out
 # shapes and phrasings, 50 lifted + 50 grounded), timed (NL2TL's lifted dev file, 100),
 # paper and disjoint (100 lifted each); $LIMIT overrides the sampled sizes. Variants: $VARIANTS (default none,C,F+C; C,F+C on
 # paper and disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
@@ -29,7 +26,8 @@ cd "$(dirname "$0")/.."
 model=${1:?usage: eval_generalization.sh MODEL NAME [SET ...]}
 name=${2:?usage: eval_generalization.sh MODEL NAME [SET ...]}
 shift 2
-sets=${*:-handwritten handwritten2 handwritten3 handwritten4 handwritten5 compositional timed paper disjoint}
+suites=$(.venv/bin/python -c "from ara.data.handwritten import SUITES; print(*SUITES)")
+sets=${*:-$suites compositional timed paper disjoint}
 variants=${VARIANTS:-none,C,F+C}
 out=runs/generalization/$name
 
@@ -44,7 +42,8 @@ run() {  # SPLIT FORM LIMIT [VARIANTS]
 
 for set in $sets; do
   case $set in
-  handwritten|handwritten2|handwritten3|handwritten4|handwritten5)
+  handwritten*)
+    [[ " $suites " == *" $set "* ]] || { echo "unknown suite $set ($suites)" >&2; exit 2; }
     run "$set" lifted 200; run "$set" grounded 200 ;;
   compositional) run compositional lifted "${LIMIT:-50}"; run compositional grounded "${LIMIT:-50}" ;;
   timed) run timed lifted "${LIMIT:-100}" ;;
@@ -67,8 +66,7 @@ PY
       --no-progress --out "$out/timed-unseen-lifted" > /dev/null
     echo "done: $name timed-unseen" ;;
   paper|disjoint) run "$set" lifted "${LIMIT:-100}" "${VARIANTS:-C,F+C}" ;;
-  *) echo "unknown set $set (handwritten handwritten2 handwritten3 handwritten4 handwritten5" \
-          "compositional timed timed-unseen paper disjoint)" >&2
+  *) echo "unknown set $set ($suites compositional timed timed-unseen paper disjoint)" >&2
      exit 2 ;;
   esac
 done

@@ -28,6 +28,8 @@ from collections import defaultdict
 from datetime import date
 from pathlib import Path
 
+from ara.data.handwritten import SUITES
+
 #: Results folder -> (label, (split, data version) the model trained on, or None).
 MODELS = {
     "base-270m": ("base", None),
@@ -130,11 +132,7 @@ MODELS = {
     "compositional-adapter-270m": ("soup v16+v17 (shipped until 2026-11-26)",
                                    ("compositional", "89be643cc979")),
 }
-SETS = [("handwritten", "lifted"), ("handwritten", "grounded"),
-        ("handwritten2", "lifted"), ("handwritten2", "grounded"),
-        ("handwritten3", "lifted"), ("handwritten3", "grounded"),
-        ("handwritten4", "lifted"), ("handwritten4", "grounded"),
-        ("handwritten5", "lifted"), ("handwritten5", "grounded"),
+SETS = [*((suite, form) for suite in SUITES for form in ("lifted", "grounded")),
         ("compositional", "lifted"), ("compositional", "grounded"),
         ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
 VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]
