@@ -14,7 +14,9 @@ model answered it or any change it judges, and is never read to guide data or ch
 ``handwritten/suite5.yaml`` (split ``handwritten5``, 134 entries, in domains no earlier
 suite covers: restaurant kitchens, construction sites, lab automation, ports and ships,
 planetary rovers) was written blind on 2026-11-26 by the same rules, before any model
-answered it, and is likewise never read to guide anything.
+answered it, and is likewise never read to guide anything; ``handwritten/suite6.yaml``
+(split ``handwritten6``, 138 entries: retail, mining, marine inspection, airport ground
+operations, security patrol) was written blind on 2026-11-27 by the same rules.
 """
 
 from __future__ import annotations
@@ -33,9 +35,10 @@ SUITE2 = Path(__file__).parent / "handwritten" / "suite2.yaml"
 SUITE3 = Path(__file__).parent / "handwritten" / "suite3.yaml"
 SUITE4 = Path(__file__).parent / "handwritten" / "suite4.yaml"
 SUITE5 = Path(__file__).parent / "handwritten" / "suite5.yaml"
+SUITE6 = Path(__file__).parent / "handwritten" / "suite6.yaml"
 #: Each hand-written split and its file; a split's records carry its name as source.
 SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3,
-          "handwritten4": SUITE4, "handwritten5": SUITE5}
+          "handwritten4": SUITE4, "handwritten5": SUITE5, "handwritten6": SUITE6}
 
 
 @dataclass(frozen=True)
@@ -49,7 +52,9 @@ class SuiteEntry:
         domain: ``lifted``, ``navigation``, ``manipulation`` or ``warehouse`` (the first
             three suites); ``lifted``, ``household``, ``drones``, ``hospital``,
             ``manufacturing`` or ``agriculture`` (the fourth); ``lifted``,
-            ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth).
+            ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth);
+            ``lifted``, ``retail``, ``mining``, ``marine``, ``airport`` or ``security``
+            (the sixth).
     """
 
     nl: str
