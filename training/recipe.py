@@ -74,7 +74,9 @@ class LoRAFinetuneRecipe:
         from transformers import AutoTokenizer
 
         self.tokenizer = AutoTokenizer.from_pretrained(self.model_dir, local_files_only=True)
-        self.train_records, self.split = self._load_data()
+        # The first use of a registered split prepares it; one process writes it.
+        with self.accelerator.main_process_first():
+            self.train_records, self.split = self._load_data()
         per_epoch = -(-len(self.train_records) // self.config.optim.batch_size)
         total = per_epoch * self.config.optim.epochs // self.config.optim.grad_accum
         self.total_steps = min(total, self.config.max_steps or total)
