@@ -31,6 +31,10 @@ def _build(cls, data: dict | None, where: str):
 #: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
 #: by ``--model`` name, beside their GGUF.
 SHIPPED_PEFT = {"finetuned": SHIPPED / "gemma3-270m-nl2tl-lora-peft"}
+#: Run settings that leave the adapter as it is: how often a run checkpoints, how many
+#: checkpoints it keeps, and the held-out check at its end. A resumed run may change
+#: them, and a recipe stage's identity leaves them out.
+BOOKKEEPING = frozenset({"eval_pairs", "checkpoint_every", "keep_checkpoints"})
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from tqdm import tqdm
 from ara import __version__
 from ara.errors import ConfigError
 from ara.provenance import differing
-from ara.training.config import TrainConfig
+from ara.training.config import BOOKKEEPING, TrainConfig
 from ara.training.dataset import (
     answer_loss_sum,
     batch_shots,
@@ -319,8 +319,8 @@ class LoRAFinetuneRecipe:
 
 
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
-#: how often it checkpoints and how many it keeps, and the held-out check at its end.
-_RESUMABLE_KEYS = {"max_steps", "eval_pairs", "checkpoint_every", "keep_checkpoints"}
+#: and those that leave the adapter as it is.
+_RESUMABLE_KEYS = BOOKKEEPING | {"max_steps"}
 
 
 def _warm_started(base, folder: str, lora):

@@ -35,13 +35,9 @@ from pathlib import Path
 from typing import Any
 
 from ara.errors import ConfigError, did_you_mean
-from ara.training.config import TrainConfig
+from ara.training.config import BOOKKEEPING, TrainConfig
 
 KINDS = ("train", "soup", "export")
-#: Training settings that leave the adapter as it is, and so are not part of a stage's
-#: identity: a stage trained with the held-out check off (say, on a GPU box without Spot)
-#: counts as done where the check is on.
-BOOKKEEPING = frozenset({"eval_pairs", "checkpoint_every", "keep_checkpoints"})
 
 
 @dataclass(frozen=True)
@@ -140,6 +136,8 @@ class StagedRecipe:
         for stage in self.stages:
             settings = stage.settings
             if stage.kind == "train":
+                # A stage trained with the held-out check off (say, on a GPU box without
+                # Spot) counts as done where the check is on.
                 settings = {k: v for k, v in self.train_config(stage).to_dict().items()
                             if k not in BOOKKEEPING}
             blob = json.dumps({"kind": stage.kind, "settings": settings,
