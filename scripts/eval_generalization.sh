@@ -8,8 +8,9 @@
 # (default: all): each hand-written suite of ara.data.handwritten.SUITES (all of its
 # entries; docs/data.md says which were read to guide what), compositional (held-out
 # shapes and phrasings, 50 lifted + 50 grounded), timed (NL2TL's lifted dev file, 100),
-# paper and disjoint (100 lifted each); $LIMIT overrides the sampled sizes. Variants: $VARIANTS (default none,C,F+C; C,F+C on
-# paper and disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
+# paper and disjoint (100 lifted each); $LIMIT overrides those sampled sizes (a suite
+# always runs whole). Variants: $VARIANTS (default none,C,F+C; C,F+C on paper and
+# disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
 # Spot's limit 5 s a pair (undecided counts as wrong); $REPAIR (default 0) turns repair on
 # when a constrained answer leaves part of the request out (`ara eval ablation --repair`,
 # $REPAIR answers drawn where sampling is the way), by $REPAIR_BY (default samples+edits),
