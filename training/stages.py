@@ -264,7 +264,12 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
         same = bool(state and state.get("fingerprint") == prints[stage.name]
                     and not ran.intersection(stage.inputs))
         if same and state.get("done"):
-            log(f"stage {stage.name}: done, skipped")
+            # Held-out checks do not change the adapter, so a stage trained without one
+            # (on a box without Spot) stays done; say so rather than leave it unnoticed.
+            unchecked = (stage.kind == "train" and recipe.train_config(stage).eval_pairs
+                         and not (folder / "heldout.json").is_file())
+            log(f"stage {stage.name}: done, skipped"
+                + (" (trained without the held-out check)" if unchecked else ""))
             continue
         resume = same and stage.kind == "train" and (folder / "run.json").is_file()
         if folder.exists() and not resume:

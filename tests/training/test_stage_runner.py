@@ -129,6 +129,15 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     run_recipe(recipe, log=lines.append)
     assert all(line.endswith("done, skipped") for line in lines) and len(lines) == 4
 
+    # Asking for the held-out check later leaves the stages done, and says they lack it.
+    checked = tiny_recipe(tiny_gemma_dir, out)
+    checked["defaults"]["eval_pairs"] = 2
+    lines.clear()
+    run_recipe(StagedRecipe.from_dict(checked), log=lines.append)
+    assert lines == [f"stage {name}: done, skipped (trained without the held-out check)"
+                     for name in ("start", "refine-a", "refine-b")] + [
+        "stage soup: done, skipped"]
+
     soup_before = (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes()
     edited = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out, refine_b_seed=3))
     lines.clear()
