@@ -10,6 +10,7 @@ from ara.data.store import (
     load_or_prepare,
     load_split,
     prepare,
+    registered_version,
     to_hf,
 )
 
@@ -25,5 +26,6 @@ __all__ = [
     "load_or_prepare",
     "load_split",
     "prepare",
+    "registered_version",
     "to_hf",
 ]

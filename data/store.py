@@ -160,6 +160,11 @@ def registered_versions() -> dict[str, str]:
     return json.loads(REGISTRY.read_text()) if REGISTRY.is_file() else {}
 
 
+def registered_version(split: str, seed: int = 0) -> str | None:
+    """The version of ``split`` this release registers (None where it registers none)."""
+    return registered_versions().get(_key(split, None if split in UNSEEDED else seed))
+
+
 def _warn_if_unregistered(split: str, manifest: dict) -> None:
     key = _key(split, manifest["seed"])
     known = registered_versions().get(key)
@@ -189,7 +194,7 @@ def load_split(split: str = "paper", seed: int = 0, root: Path | None = None,
         raise ConfigError(f"unknown split {split!r}. {did_you_mean(split, SPLITS)}")
     root = root or default_root()
     key = _key(split, None if split in UNSEEDED else seed)
-    registered = registered_versions().get(key)
+    registered = registered_version(split, seed)
     version = version or registered
     if version is None:
         found = sorted(root.glob(f"{key}-*"))

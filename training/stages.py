@@ -15,8 +15,9 @@ its ``stages``, in order, each one of:
 
 Each stage writes ``OUT/NAME/`` and reads only the folders of the stages it names, so the
 recipe needs nothing but the base model and the registered data. A stage is done when
-``OUT/NAME/stage.json`` holds ``done: true`` and the fingerprint of its settings and of
-its inputs' fingerprints. A rerun skips done stages, resumes an interrupted training
+``OUT/NAME/stage.json`` holds ``done: true`` and the fingerprint of its settings (with
+the data version this release registers, where they leave it to the release) and of its
+inputs' fingerprints. A rerun skips done stages, resumes an interrupted training
 stage from its newest checkpoint and runs again, from scratch, a stage whose settings or
 inputs changed (its old folder removed), so that every stage after an edited one is
 rebuilt too. ``OUT/recipe.json`` records each stage's wall time and memory.
@@ -34,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ara.data import registered_version
 from ara.errors import ConfigError, did_you_mean
 from ara.training.config import BOOKKEEPING, TrainConfig
 
@@ -140,6 +142,12 @@ class StagedRecipe:
                 # Spot) counts as done where the check is on.
                 settings = {k: v for k, v in self.train_config(stage).to_dict().items()
                             if k not in BOOKKEEPING}
+                if settings["data"]["version"] is None:
+                    # "The version this release registers" names other data once a
+                    # release registers another: a stage trained on the old one is stale.
+                    data = settings["data"]
+                    settings["data"] = {**data, "version": registered_version(
+                        data["split"], data["seed"])}
             blob = json.dumps({"kind": stage.kind, "settings": settings,
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ara.data import registered_version
 from ara.errors import ConfigError
 from ara.training.stages import StagedRecipe, run_recipe
 
@@ -71,6 +72,23 @@ def test_a_stage_is_what_makes_its_adapter_so_bookkeeping_and_later_stages_leave
         **data["stages"][0]["train"], "max_steps": 941}}, *data["stages"][1:]]}
     assert all(a != b for a, b in zip(StagedRecipe.from_dict(retuned).fingerprints().values(),
                                       prints.values(), strict=True))
+
+
+def test_a_stage_trained_on_the_registered_data_is_stale_once_another_version_is_registered():
+    """Tests that `version: null` counts as the version this release registers: pinning
+    that very version leaves every stage done, and any other version (what a release that
+    registers new data amounts to) makes every stage stale."""
+    data = yaml.safe_load(SHIPPED_RECIPE.read_text())
+    prints = StagedRecipe.from_dict(data).fingerprints()
+
+    def pinned(version):
+        defaults = {**data["defaults"], "data": {**data["defaults"]["data"],
+                                                 "version": version}}
+        return StagedRecipe.from_dict({**data, "defaults": defaults}).fingerprints()
+
+    assert pinned(registered_version("compositional", 0)) == prints
+    assert all(a != b for a, b in zip(pinned("000000000000").values(), prints.values(),
+                                      strict=True))
 
 
 @pytest.mark.parametrize("stages, message", [
