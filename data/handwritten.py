@@ -10,13 +10,16 @@ misses, with the first suite's, guided which slips repair checks for;
 checks and is their blind measure; ``handwritten/suite4.yaml`` (split ``handwritten4``,
 167 entries, in domains no earlier suite covers: household robots, drones, hospital
 logistics, manufacturing cells, agriculture) was written blind on 2026-11-26, before any
-model answered it or any change it judges, and is never read to guide data or checks;
+model answered it or any change it judges; its misses later guided generator 3.7;
 ``handwritten/suite5.yaml`` (split ``handwritten5``, 134 entries, in domains no earlier
 suite covers: restaurant kitchens, construction sites, lab automation, ports and ships,
 planetary rovers) was written blind on 2026-11-26 by the same rules, before any model
-answered it, and is likewise never read to guide anything; ``handwritten/suite6.yaml``
+answered it, and is never read to guide anything; ``handwritten/suite6.yaml``
 (split ``handwritten6``, 138 entries: retail, mining, marine inspection, airport ground
-operations, security patrol) was written blind on 2026-11-27 by the same rules.
+operations, security patrol) was written blind on 2026-11-27 by the same rules;
+``handwritten/suite7.yaml`` (split ``handwritten7``, 147 entries: solar and wind farm
+maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfire and
+forestry) was written blind on 2026-11-27 by the same rules.
 """
 
 from __future__ import annotations
@@ -36,9 +39,11 @@ SUITE3 = Path(__file__).parent / "handwritten" / "suite3.yaml"
 SUITE4 = Path(__file__).parent / "handwritten" / "suite4.yaml"
 SUITE5 = Path(__file__).parent / "handwritten" / "suite5.yaml"
 SUITE6 = Path(__file__).parent / "handwritten" / "suite6.yaml"
+SUITE7 = Path(__file__).parent / "handwritten" / "suite7.yaml"
 #: Each hand-written split and its file; a split's records carry its name as source.
 SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3,
-          "handwritten4": SUITE4, "handwritten5": SUITE5, "handwritten6": SUITE6}
+          "handwritten4": SUITE4, "handwritten5": SUITE5, "handwritten6": SUITE6,
+          "handwritten7": SUITE7}
 
 
 @dataclass(frozen=True)
@@ -54,7 +59,8 @@ class SuiteEntry:
             ``manufacturing`` or ``agriculture`` (the fourth); ``lifted``,
             ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth);
             ``lifted``, ``retail``, ``mining``, ``marine``, ``airport`` or ``security``
-            (the sixth).
+            (the sixth); ``lifted``, ``energy``, ``rail``, ``hotel``, ``delivery`` or
+            ``forestry`` (the seventh).
     """
 
     nl: str
