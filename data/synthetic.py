@@ -56,7 +56,13 @@ step that is somewhere for good (``F(a & F(G(b)))``). Version 3.7 (after the fou
 hand-written suite's misses) draws a recurrence with a longest gap (``G(F[0,n](a))``, "at
 least once every 6 hours") and what holds unless a condition does (``G(!a -> b)``, "keep
 the gate closed unless a truck is waiting"), and says a window as "no sooner than 4 and
-no later than 9".
+no later than 9". Version 3.8 says a moment by a deadline from which something holds for
+good (``F[0,n](G(a))``) with words that last ("within 5 steps, the gate is closed for
+good"), not "within 5 steps, globally a", which repair's checks read as asking for no
+``F(G)``; counts time in minutes and hours too ("no sooner than minute 20", "within 2
+hours"), as users do, where earlier versions said only steps, time units and seconds;
+and says a window after the action as well ("dust the shelf no sooner than minute 20
+and no later than minute 50").
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators, other than
@@ -99,7 +105,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.7.0"
+SYNTHETIC_VERSION = "3.8.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.

@@ -69,7 +69,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "between {s} {lo} and {s} {hi}, {a} at least once",
              "{a} at least once between {lo} and {hi} {u} from now",
              "no sooner than {s} {lo} and no later than {s} {hi}, {a}",
-             "{a} no earlier than {lo} {u} and no later than {hi} {u} from now"),
+             "{a} no earlier than {lo} {u} and no later than {hi} {u} from now",
+             "{a} no sooner than {s} {lo} and no later than {s} {hi}"),
     "G": ("always {a}", "{a} at all times", "at every step, {a}", "{a} forever",
           "it is always the case that {a}", "globally {a}", "{a} all the time",
           "constantly {a}", "{a} the whole time"),
@@ -94,6 +95,17 @@ PHRASES: dict[str, tuple[str, ...]] = {
            "sooner or later {a} for good", "{a} eventually holds forever",
            "{a} from some point on, forever", "eventually {a} and from then on it stays so",
            "in the end, {a} permanently"),
+    # F[..](G(a)): said with words that last, since "within 5 steps, globally a" reads
+    # as a G bounded by 5 steps as much as a moment by which a starts to hold for good.
+    "FG_n": ("within {n} {u}, {a} for good", "{a} within {n} {u}, and from then on forever",
+             "no later than {s} {n}, {a}, and it stays so from then on",
+             "in the next {n} {u}, {a} from some point on, forever",
+             "{a} within the next {n} {u} and permanently after that"),
+    "FG_ab": ("at some point between {s} {lo} and {s} {hi}, {a} for good",
+              "{a} between {lo} and {hi} {u} from now, and from then on forever",
+              "no sooner than {s} {lo} and no later than {s} {hi}, {a}, and it stays so "
+              "from then on",
+              "within {lo} to {hi} {u}, {a} permanently"),
     # F(G(a)) and G(F(a)) over a place: where the robot ends up, where it keeps going.
     "FG_place": ("go to {x} and stay there", "reach {x} and remain there",
                  "get to {x} and stay there for good", "head to {x} and remain there forever",
@@ -208,6 +220,8 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "never": frozenset({"under no circumstances {a}"}),
     "never_n": frozenset({"{a} must not happen within {n} {u}"}),
     "FG": frozenset({"{a} from some point on, forever"}),
+    "FG_n": frozenset({"{a} within the next {n} {u} and permanently after that"}),
+    "FG_ab": frozenset({"within {lo} to {hi} {u}, {a} permanently"}),
     "GF": frozenset({"keep returning to {a} forever"}),
     "GF_n": frozenset({"{a} every {n} {u} or more often"}),
     "unless": frozenset({"{b}, except when {a}"}),
@@ -233,6 +247,7 @@ HELD_OUT: dict[str, frozenset[str]] = {
 #: Time units: (plural, singular or None where "step 5" would not read).
 UNITS: tuple[tuple[str, str | None], ...] = (
     ("steps", "step"), ("time steps", "time step"), ("time units", None), ("seconds", None),
+    ("minutes", "minute"), ("hours", "hour"),
 )
 MODES = ("all", "train", "test")
 #: Plain bracketing forms, said only when every operand is a proposition or its negation.
@@ -465,6 +480,10 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             and gap.interval.hi is not None:
         # "at least once every 6 steps"
         return r.pick("GF_n", used, a=sub(gap.arg), n=gap.interval.hi)
+    if isinstance(f, Eventually) and f.interval is not None and f.interval.hi is not None \
+            and _untimed(f.arg, Always) is not None:
+        # "within 5 steps, the gate is closed for good"
+        return _timed("FG", f.interval, r, used, a=sub(f.arg.arg))
     for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
         inner = _untimed(f, outer)
         if inner is not None and _untimed(inner, nested) is not None:

@@ -15,7 +15,8 @@ CUES = {
                                 "U", "U_n", "U_ab")),
     "recurs": (cues.RECURRING_WORDS.search, ("GF", "GF_place", "GF2_place")),
     "may recur": (cues.AGAIN_AND_AGAIN_WORDS.search, ("GF", "GF_place", "GF2_place")),
-    "may hold for good": (cues.FOR_GOOD_WORDS.search, ("FG", "FG_place", "F_then_G")),
+    "may hold for good": (cues.FOR_GOOD_WORDS.search, ("FG", "FG_n", "FG_ab", "FG_place",
+                                                        "F_then_G")),
     "in order": (cues.says_in_order, ("sequence", "sequence_n", "sequence3")),
     "in any order": (cues.ANY_ORDER_WORDS.search, ("visit_any",)),
 }
