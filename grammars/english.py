@@ -7,7 +7,8 @@ construct, a time unit and a sentence layout, so one formula becomes many senten
 
 Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infinitely
 often", ``G(a -> F(b))`` "whenever a, eventually b", ``G(F[0,n](a))`` "a at least once
-every n steps", ``G(!a -> b)`` "b unless a", ``F(a & F(b))`` "first a, then b",
+every n steps", ``F[0,n](G(a))`` "within n steps, a for good", ``G(!a -> b)`` "b
+unless a", ``F(a & F(b))`` "first a, then b",
 ``F(a & F[0,n](b))`` "a, and within n steps after that, b", ``!a U b`` "do not a until
 b", ``F(a & G(b))`` "eventually a, and from then on always b", ``(a | b) & !(a & b)`` "a
 or b, but not both"; in sampled sentences also ``F(a) & F(b)`` "a and b, in any order",
@@ -44,6 +45,7 @@ from ara.grammars.ast import (
     Or,
     Until,
     conjuncts,
+    walk,
 )
 
 # {a}, {b}: operands; {n}: an upper bound from 0; {lo}, {hi}: a window; {u}: the unit,
@@ -105,7 +107,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
               "{a} between {lo} and {hi} {u} from now, and from then on forever",
               "no sooner than {s} {lo} and no later than {s} {hi}, {a}, and it stays so "
               "from then on",
-              "within {lo} to {hi} {u}, {a} permanently"),
+              "within {lo} to {hi} {u}, {a} permanently",
+              "after {lo} {u} but no later than {hi} {u}, {a} for good"),
     # F(G(a)) and G(F(a)) over a place: where the robot ends up, where it keeps going.
     "FG_place": ("go to {x} and stay there", "reach {x} and remain there",
                  "get to {x} and stay there for good", "head to {x} and remain there forever",
@@ -221,7 +224,7 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "never_n": frozenset({"{a} must not happen within {n} {u}"}),
     "FG": frozenset({"{a} from some point on, forever"}),
     "FG_n": frozenset({"{a} within the next {n} {u} and permanently after that"}),
-    "FG_ab": frozenset({"within {lo} to {hi} {u}, {a} permanently"}),
+    "FG_ab": frozenset({"{a} between {lo} and {hi} {u} from now, and from then on forever"}),
     "GF": frozenset({"keep returning to {a} forever"}),
     "GF_n": frozenset({"{a} every {n} {u} or more often"}),
     "unless": frozenset({"{b}, except when {a}"}),
@@ -378,7 +381,8 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
         return r.pick("F_do", used, a=sub(f.arg))
     if isinstance(f, (Eventually, Always)):
         op = "F" if isinstance(f, Eventually) else "G"
-        return _timed(op, f.interval, r, used, a=sub(f.arg))
+        allow = _said_first(f.arg) if op == "F" else None
+        return _timed(op, f.interval, r, used, allow=allow, a=sub(f.arg))
     if isinstance(f, (And, Or)):
         op = "&" if isinstance(f, And) else "|"
         key = op + "()" if embedded else op
@@ -447,15 +451,28 @@ def _sometimes(f: Formula, say: Callable[[str], str | None], r: Realizer) -> str
 
 
 def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | None,
-           **slots: str) -> str:
+           allow: Callable[[str], bool] | None = None, **slots: str) -> str:
     """An operator with its interval: untimed, ``[0,n]`` or a window ``[lo,hi]``."""
     if interval is None:
-        return r.pick(op, used, **slots)
+        return r.pick(op, used, allow=allow, **slots)
     if interval.hi is None:  # [lo,inf]: no construct of its own; say the lower bound
-        return r.pick(op, used, **slots) + f" (from step {interval.lo} on)"
+        return r.pick(op, used, allow=allow, **slots) + f" (from step {interval.lo} on)"
     if interval.lo == 0:
-        return r.pick(op + "_n", used, n=interval.hi, **slots)
-    return r.pick(op + "_ab", used, lo=interval.lo, hi=interval.hi, **slots)
+        return r.pick(op + "_n", used, allow=allow, n=interval.hi, **slots)
+    return r.pick(op + "_ab", used, allow=allow, lo=interval.lo, hi=interval.hi, **slots)
+
+
+def _said_first(operand: Formula) -> Callable[[str], bool] | None:
+    """Which phrasings of an ``F`` may say ``operand`` first: not a negation, since "do
+    not go to the kitchen within 5 steps" reads as never going there in that time."""
+    if not isinstance(operand, Not):
+        return None
+    return lambda p: not p.startswith("{a}")
+
+
+def _timeless(f: Formula) -> bool:
+    """Whether ``f`` has no temporal operator (it speaks of one instant)."""
+    return not any(isinstance(g, (Eventually, Always, Until, Next)) for g in walk(f))
 
 
 def _untimed(f: Formula, op: type) -> Formula | None:
@@ -481,9 +498,10 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         # "at least once every 6 steps"
         return r.pick("GF_n", used, a=sub(gap.arg), n=gap.interval.hi)
     if isinstance(f, Eventually) and f.interval is not None and f.interval.hi is not None \
-            and _untimed(f.arg, Always) is not None:
+            and _untimed(f.arg, Always) is not None and _timeless(f.arg.arg):
         # "within 5 steps, the gate is closed for good"
-        return _timed("FG", f.interval, r, used, a=sub(f.arg.arg))
+        return _timed("FG", f.interval, r, used, allow=_said_first(f.arg.arg),
+                      a=sub(f.arg.arg))
     for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
         inner = _untimed(f, outer)
         if inner is not None and _untimed(inner, nested) is not None:
@@ -509,8 +527,8 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         return r.pick("xor", used, a=_choice(one, r, used, now), b=_choice(other, r, used, now))
     if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies):
         lhs, rhs = f.arg.lhs, f.arg.rhs
-        if isinstance(rhs, Eventually) and (rhs.interval is None or
-                                             (rhs.interval.lo == 0 and rhs.interval.hi)):
+        if isinstance(rhs, Eventually) and (rhs.interval is None or (
+                rhs.interval.lo == 0 and rhs.interval.hi and _untimed(rhs.arg, Always) is None)):
             command = isinstance(rhs.arg, Atom) and r.is_action(rhs.arg.name) \
                 and not r.is_lasting(rhs.arg.name)
             if rhs.interval is None and command and r.rng is not None and r.rng.random() < 0.7:
