@@ -63,7 +63,7 @@ HOLDS_WORDS = re.compile(
 HAPPENS_WORDS = re.compile(
     r"\b(eventually|at some (?:point|time|moment|step)|sooner or later|at least once"
     r"|sometime|someday|ultimately|finally|in the end|at one point"
-    r"|(?:by|no later than|before) (?:step|time) \d+)\b")
+    r"|(?:by|no later than|before) (?:time step|step|time|second|minute|hour) \d+)\b")
 #: Words that ask for something again and again (:data:`AGAIN_AND_AGAIN`), a strict
 #: part of :data:`AGAIN_AND_AGAIN_WORDS`: each of these says it, not only allows it.
 RECURRING_WORDS = re.compile(
