@@ -218,6 +218,25 @@ def _peak_memory() -> dict:
     return peak
 
 
+def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str]) -> str:
+    """Why the folder of ``stage`` cannot be kept, in words for the log."""
+    if ran.intersection(stage.inputs):
+        return "a stage it reads was rebuilt"
+    run = recipe.folder(stage.name) / "run.json"
+    if stage.kind == "train" and run.is_file():
+        data = recipe.train_config(stage).data
+        trained = json.loads(run.read_text())["data"]["version"]
+        wanted = data.version or registered_version(data.split, data.seed)
+        if trained != wanted:
+            return (f"it was trained on {data.split} version {trained} and this run asks for "
+                    f"{wanted} (to keep it, pin data.version: {trained} in the config, "
+                    "where that version is still prepared)")
+    if state is None:
+        return "its folder holds no stage record"
+    return "its settings changed" if run.is_file() or stage.kind != "train" else (
+        "it stopped before its run began")
+
+
 def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
                max_steps: int | None) -> dict:
     folder = recipe.folder(stage.name)
@@ -282,6 +301,7 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
         resume = same and stage.kind == "train" and (folder / "run.json").is_file()
         if folder.exists() and not resume:
             # Made with other settings or from other inputs: it would mix two recipes.
+            log(f"stage {stage.name}: {_stale(recipe, stage, state, ran)}; rebuilding it")
             shutil.rmtree(folder)
             record["stages"].pop(stage.name, None)
         log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")
