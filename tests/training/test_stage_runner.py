@@ -156,29 +156,21 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
                      for name in ("start", "refine-a", "refine-b")] + [
         "stage soup: done, skipped"]
 
+    # An edited stage is rebuilt with the stages that read it, and the log says why (here
+    # refine-b was also trained on data an earlier release registered).
     soup_before = (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes()
+    run_json = out / "refine-b" / "run.json"
+    run = json.loads(run_json.read_text())
+    run_json.write_text(json.dumps({**run, "data": {**run["data"], "version": "000000000000"}}))
     edited = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out, refine_b_seed=3))
     lines.clear()
     run_recipe(edited, log=lines.append)
     assert [line for line in lines if "skipped" in line] == [
         "stage start: done, skipped", "stage refine-a: done, skipped"]
-    assert lines[2:] == [
-        "stage refine-b: its settings changed; rebuilding it", "stage refine-b: started (train)",
-        "stage refine-b: done in " + lines[4].split(" in ")[1],
-        "stage soup: a stage it reads was rebuilt; rebuilding it", "stage soup: started (soup)",
-        "stage soup: done in " + lines[7].split(" in ")[1]]
-    assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
-
-    # A stage trained on data an earlier release registered says so when it is rebuilt.
-    run_json = out / "refine-b" / "run.json"
-    run = json.loads(run_json.read_text())
-    run["data"]["version"] = "000000000000"
-    run_json.write_text(json.dumps(run))
-    state = json.loads((out / "refine-b" / "stage.json").read_text())
-    (out / "refine-b" / "stage.json").write_text(json.dumps({**state, "fingerprint": "old"}))
-    lines.clear()
-    run_recipe(edited, log=lines.append)
-    assert lines[2] == (
+    assert [line for line in lines if "rebuilding" in line] == [
         "stage refine-b: it was trained on paper version 000000000000 and this run asks "
         f"for {registered_version('paper', 0)} (to keep it, pin data.version: "
-        "000000000000 in the config, where that version is still prepared); rebuilding it")
+        "000000000000 in the config, where that version is still prepared); rebuilding it",
+        "stage soup: a stage it reads was rebuilt; rebuilding it"]
+    assert "stage refine-b: started (train)" in lines and "stage soup: started (soup)" in lines
+    assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
