@@ -139,6 +139,13 @@ class DataSettings:
             raise ConfigError(f"data.repeat must map source names to counts >= 1, "
                               f"got {self.repeat!r}")
 
+    def resolved_version(self) -> str | None:
+        """The version the run trains on: the pinned one, else the one this release
+        registers (None where it registers none for this seed)."""
+        from ara.data import registered_version
+
+        return self.version or registered_version(self.split, self.seed)
+
 
 @dataclass(frozen=True)
 class TrainConfig:

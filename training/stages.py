@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ara.data import registered_version
 from ara.errors import ConfigError, did_you_mean
 from ara.training.config import BOOKKEEPING, TrainConfig
 
@@ -140,14 +139,12 @@ class StagedRecipe:
             if stage.kind == "train":
                 # A stage trained with the held-out check off (say, on a GPU box without
                 # Spot) counts as done where the check is on.
-                settings = {k: v for k, v in self.train_config(stage).to_dict().items()
-                            if k not in BOOKKEEPING}
-                if settings["data"]["version"] is None:
-                    # "The version this release registers" names other data once a
-                    # release registers another: a stage trained on the old one is stale.
-                    data = settings["data"]
-                    settings["data"] = {**data, "version": registered_version(
-                        data["split"], data["seed"])}
+                config = self.train_config(stage)
+                settings = {k: v for k, v in config.to_dict().items() if k not in BOOKKEEPING}
+                # "The version this release registers" names other data once a release
+                # registers another: a stage trained on the old one is stale.
+                settings["data"] = {**settings["data"],
+                                    "version": config.data.resolved_version()}
             blob = json.dumps({"kind": stage.kind, "settings": settings,
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)
@@ -226,7 +223,7 @@ def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str]
     if stage.kind == "train" and run.is_file():
         data = recipe.train_config(stage).data
         trained = json.loads(run.read_text())["data"]["version"]
-        wanted = data.version or registered_version(data.split, data.seed)
+        wanted = data.resolved_version()
         if trained != wanted:
             return (f"it was trained on {data.split} version {trained} and this run asks for "
                     f"{wanted} (to keep it, pin data.version: {trained} in the config, "
