@@ -1,11 +1,15 @@
 """Base vs fine-tuned Gemma 3 270M, from the samples of the README's evaluation runs.
 
-    .venv/bin/python scripts/compare_models.py [--results runs]
+    mkdir -p runs/paper-record
+    git archive f4bf9e7 docs/results | tar -x --strip-components=2 -C runs/paper-record
+    .venv/bin/python scripts/compare_models.py --results runs/paper-record
 
 For each split, variant and shot count: accuracy and validity over *all* test pairs (an
-invalid or undecided answer counts as wrong), averaged over reruns. The runs are the
-ones `scripts/finetune_270m.sh eval disjoint` writes, the base model's 5-shot runs, and
-the first adapter's (480 steps, zero-shot prompts only) kept for comparison.
+invalid or undecided answer counts as wrong), averaged over reruns. It reads the run
+folders (with their answers) of docs/paper-adapter.md's table, which commit f4bf9e7
+holds: the base model's 5-shot and zero-shot runs, the paper-split adapter's, and the
+first adapter's (480 steps, zero-shot prompts only). Runs of your own under the same
+names (`ara eval ablation --out runs/base-270m-paper ...`) read the same.
 """
 
 from __future__ import annotations
@@ -66,7 +70,7 @@ def main() -> None:
 
 def ceilings(results: Path) -> str:
     """What the labels allow on each split's sample (see `ara eval ceiling`)."""
-    from ara.data import load_split
+    from ara.data import load_or_prepare
     from ara.eval.ceiling import split_ceiling
 
     lines = []
@@ -75,7 +79,7 @@ def ceilings(results: Path) -> str:
         if not run.exists():
             continue
         c = json.loads(run.read_text())["config"]
-        ceiling = split_ceiling(load_split(split, c["data_seed"]), c["form"], c["limit"],
+        ceiling = split_ceiling(load_or_prepare(split, c["data_seed"]), c["form"], c["limit"],
                                 c["seed"])
         lines.append(f"{split}: a translator that follows the training labels can get at most "
                      f"{ceiling.train_majority}/{ceiling.records} of these pairs right "
