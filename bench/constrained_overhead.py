@@ -5,7 +5,7 @@ translated unconstrained and constrained, and the time per formula is compared.
 Then llama.cpp runs the same prompts with and without reusing the KV cache of the
 shared few-shot prefix. All numbers come from this one run on this machine.
 
-    .venv/bin/python bench/constrained_overhead.py [--n 20] [--hf]
+    .venv/bin/python bench/constrained_overhead.py [--n 20] [--hf] [--builtin]
 
 Time per formula depends on the answer's length, and a constrained answer can differ
 from the free one, so the table also reports generated tokens and time per token.

@@ -1,7 +1,8 @@
 """Which extra answers fix a translation that leaves part of the request out?
 
 Takes the answers a repaired evaluation run had to repair (``attempts > 1`` in its
-samples.jsonl: the greedy answer left out a listed proposition or a stated bound), or
+samples.jsonl: the greedy answer had a gap of :data:`ara.eval.translate.checks.KINDS`, or the
+model doubted it), or
 the test pairs of a split whose greedy answer has such a gap (``--split``: the first
 ``--limit`` of its test side shuffled with seed 0, less the sentences of the runs
 ``--exclude`` names, so that answers already read are left out), translates each

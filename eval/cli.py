@@ -18,7 +18,8 @@ from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
                        no_args_is_help=True)
 
-MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), default (without), "
+MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (with "
+              "the paper split's), default (without), "
               "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint")
 SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
                "llama, vllm, sglang, or openai (none: constrained decoding is refused).")

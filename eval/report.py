@@ -56,8 +56,9 @@ def _cell(stat: dict) -> str:
 
 def data_name(meta: dict) -> str:
     """The split's name, or for a run on a user's file that file's name."""
-    files = meta.get("data_files")
-    return Path(next(iter(files))).name if files else meta["data"]["split"]
+    # data_files also holds the worked examples' file, and may list it first
+    file = meta["config"].get("data")
+    return Path(file).name if file else meta["data"]["split"]
 
 
 def tables_markdown(results: Results) -> str:

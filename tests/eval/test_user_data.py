@@ -181,3 +181,16 @@ def test_an_ablation_on_ones_own_file_is_judged_reported_and_resumed(tmp_path):
     write(data, PAIRS[:2])
     resumed = subprocess.run([*args, "--resume"], capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 2 and "different data" in resumed.stderr
+
+
+def test_the_tables_name_the_test_file_not_the_examples_file():
+    """Tests the data a run's tables name: the file under test, even where the worked
+    examples' file sorts before it among the files the run read."""
+    from ara.eval.report import data_name
+
+    meta = {"config": {"data": "data/examples/lab-test.jsonl",
+                       "examples": "data/examples/lab-pairs.jsonl"},
+            "data_files": {"data/examples/lab-pairs.jsonl": "bb", "data/examples/lab-test.jsonl": "77"},
+            "data": {"split": "file"}}
+    assert data_name(meta) == "lab-test.jsonl"
+    assert data_name({"config": {}, "data": {"split": "paper"}}) == "paper"
