@@ -6,7 +6,7 @@ import pytest
 
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
-from ara.training.recipe import LoRAFinetuneRecipe
+from ara.training.recipe import LoRAFinetuneRecipe, run_training
 
 
 @pytest.fixture(scope="module")
@@ -46,6 +46,14 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
     resumed.setup()
     assert resumed.step == 6
     assert len(resumed.train()) == 2 and resumed.step == 8
+    # The run's summary reads its log, so a session killed outright (which records no
+    # time of its own) still counts: the first loss is step 1's, the seconds every step's.
+    resumed.save_checkpoint()
+    summary = run_training(TrainConfig.from_dict({**config.to_dict(), "max_steps": 9}),
+                           resume=True)
+    log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]
+    assert summary["steps"] == 9 and len(log) == 9 and summary["first_loss"] == log[0]["loss"]
+    assert summary["step_seconds"] == round(sum(x["seconds"] for x in log), 1) > 0
     with pytest.raises(Exception, match="already holds a run"):
         LoRAFinetuneRecipe(config)
     # Resuming with another learning rate would silently train something else.
