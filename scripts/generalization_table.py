@@ -2,14 +2,18 @@
 ``scripts/eval_generalization.sh`` wrote.
 
     .venv/bin/python scripts/generalization_table.py [--results runs/generalization]
+        [--models shipped-greedy,candidate] [--test compositional=2cc898a81b54]
+        [--trained-on NAME=SPLIT:VERSION]
 
-    .venv/bin/python scripts/generalization_table.py --test compositional=2cc898a81b54
+Each folder of ``--results`` holding runs is a model (``--models`` picks and orders
+them), its column headed by the folder's name.
 
 A cell is accuracy / validity in % over all pairs of the run (invalid and undecided
 answers count as wrong). ``unseen`` is the accuracy on the pairs whose sentence does
-not occur in that model's own training data (the data version it trained on, where
-that version is prepared on this machine; else the current one, and the output says
-so), the figure that says what a user's new sentence can expect; the paper split's
+not occur in that model's own training data: the version a shipped adapter's record in
+``eval/models/`` names (found by the adapter's hash in the run's model id), the one
+``--trained-on`` gives, else for an adapter the registered compositional mixture and
+for the base model nothing (the output says which it assumed), the figure that says what a user's new sentence can expect; the paper split's
 lifted test side is almost all seen. A run whose pairs are not all pairs of the test
 data (the registered version, or the one ``--test SPLIT=VERSION`` names) is left out
 and listed: the timed dev file's labels were corrected in timed version 5f389aa2c4b4,
@@ -30,112 +34,33 @@ from pathlib import Path
 
 from ara.data.handwritten import SUITES
 
-#: Results folder -> (label, (split, data version) the model trained on, or None).
-MODELS = {
-    "base-270m": ("base", None),
-    "paper-adapter-270m": ("paper adapter (old)", ("paper", "1de1d813ead6")),
-    "compositional-adapter-v1-270m": ("compositional adapter v1",
-                                      ("compositional", "7694e7d55174")),
-    "compositional-adapter-v2-270m": ("compositional adapter v2",
-                                      ("compositional", "c3c2564014d2")),
-    "compositional-adapter-v3-270m": ("compositional adapter v3",
-                                      ("compositional", "2cc898a81b54")),
-    "compositional-adapter-v4-270m": ("compositional adapter v4",
-                                      ("compositional", "2cc898a81b54")),
-    "compositional-adapter-v5-270m": ("compositional adapter v5 (not shipped)",
-                                      ("compositional", "2cc898a81b54")),
-    "compositional-adapter-v6-270m": ("compositional adapter v6 (not shipped)",
-                                      ("compositional", "820c2d11c0c8")),
-    "compositional-adapter-v7-270m": ("compositional adapter v7 (not shipped)",
-                                      ("compositional", "6c3132045205")),
-    "compositional-adapter-v8-270m": ("compositional adapter v8 (not shipped)",
-                                      ("compositional", "6c3132045205")),
-    "compositional-adapter-v9-270m": ("compositional adapter v9 (v7, seed 6; not shipped)",
-                                      ("compositional", "6c3132045205")),
-    "soup-v4v7v8-270m": ("soup v4+v7+v8 (not shipped)", ("compositional", "6c3132045205")),
-    "soup-v7v8v9-270m": ("soup v7+v8+v9 (not shipped)", ("compositional", "6c3132045205")),
-    "soup-v7v9-270m": ("soup v7+v9 (not shipped)", ("compositional", "6c3132045205")),
-    "compositional-adapter-v10-270m": ("compositional adapter v10 (v7, timed rows x2)",
-                                       ("compositional", "6c3132045205")),
-    "compositional-adapter-v11-270m": ("compositional adapter v11 (v10 on 3.2.0)",
-                                       ("compositional", "690d5d4a1e5f")),
-    "compositional-adapter-v12-270m": ("compositional adapter v12 (v11, seed 6)",
-                                       ("compositional", "690d5d4a1e5f")),
-    "compositional-adapter-v13-270m": ("compositional adapter v13 (v11 on 3.3.0)",
-                                       ("compositional", "9c33668eac7c")),
-    "compositional-adapter-v14-270m": ("compositional adapter v14 (v13 trained on, on 3.4.0)",
-                                       ("compositional", "aaa2649e1656")),
-    "soup-v13v14-270m": ("soup v13+v14 (shipped until 2026-11-24)",
-                         ("compositional", "aaa2649e1656")),
-    "compositional-adapter-v15-270m": ("compositional adapter v15 (soup v13+v14 on 3.5.0)",
-                                       ("compositional", "89be643cc979")),
-    "soup-v13v14-v15-270m": ("soup (v13+v14)+v15 (shipped until 2026-11-24)",
-                             ("compositional", "89be643cc979")),
-    "soup-shipped-r32-270m": ("soup (v13+v14)+v15 at rank 32 (SVD)",
-                              ("compositional", "89be643cc979")),
-    "soup-shipped-r16-270m": ("soup (v13+v14)+v15 at rank 16 (SVD)",
-                              ("compositional", "89be643cc979")),
-    "compositional-adapter-v16-270m": ("compositional adapter v16 (rank-16 soup on 3.5.0)",
-                                       ("compositional", "89be643cc979")),
-    "soup-r16v16-270m": ("soup (rank-16 soup)+v16 at rank 16",
-                         ("compositional", "89be643cc979")),
-    "compositional-adapter-v17-270m": ("compositional adapter v17 (v16 trained on, seed 10)",
-                                       ("compositional", "89be643cc979")),
-    "compositional-adapter-v18-270m": ("compositional adapter v18 (v16 on 3.6.0)",
-                                       ("compositional", "e910409c3f2c")),
-    "soup-v16v17-270m": ("soup v16+v17 at rank 16", ("compositional", "89be643cc979")),
-    "compositional-adapter-v19-270m": ("compositional adapter v19 (soup v16+v17 on 3.6.0, "
-                                       "150 steps, lr 1e-4)", ("compositional", "e910409c3f2c")),
-    "compositional-adapter-v20-270m": ("compositional adapter v20 (v19, seed 13)",
-                                       ("compositional", "e910409c3f2c")),
-    "soup-s-v19-270m": ("soup (v16+v17)+v19 at rank 16", ("compositional", "e910409c3f2c")),
-    "soup-s-v19-v20-270m": ("soup (v16+v17)+v19+v20 at rank 16",
-                            ("compositional", "e910409c3f2c")),
-    "soup-s-v20-270m": ("soup (v16+v17)+v20 at rank 16", ("compositional", "e910409c3f2c")),
-    "soup-v16v17-repair8-270m": ("soup v16+v17 (shipped), repair 8 by samples",
-                                 ("compositional", "89be643cc979")),
-    "soup-v16v17-edits-270m": ("soup v16+v17 (shipped), repair 8 by edits",
-                               ("compositional", "89be643cc979")),
-    "soup-v16v17-samples-edits-270m": ("soup v16+v17 (shipped), repair 8 by samples+edits",
-                                       ("compositional", "89be643cc979")),
-    "soup-v16v17-doubt-270m": ("soup v16+v17 (shipped), repair 8 by samples+edits, doubt 0.5",
-                               ("compositional", "89be643cc979")),
-    "soup-v16v17-fresh-270m": ("soup v16+v17 (shipped), greedy, history-independent "
-                               "backend (2026-11-25)", ("compositional", "89be643cc979")),
-    "soup-v16v17-doubt-fresh-270m": ("soup v16+v17 (shipped), as ara translate, "
-                                     "history-independent backend (2026-11-25)",
-                                     ("compositional", "89be643cc979")),
-    "soup-v16v17-unasked-270m": ("soup v16+v17 (shipped), as ara translate, repair also "
-                                 "on operators nested unasked (2026-11-25)",
-                                 ("compositional", "89be643cc979")),
-    "soup-v16v17-order-270m": ("soup v16+v17 (shipped), as ara translate, repair also "
-                               "on order left out or unasked (2026-11-25)",
-                               ("compositional", "89be643cc979")),
-    "soup-v16v17-claims-270m": ("soup v16+v17 (shipped), as ara translate, repair also "
-                                "on G, F, G(F) asked for in words (2026-11-25)",
-                                ("compositional", "89be643cc979")),
-    "soup-v16v17-full-270m": ("soup v16+v17 (shipped), every variant, history-independent "
-                              "backend (2026-11-25)", ("compositional", "89be643cc979")),
-    "soup-v16v18-270m": ("soup v16+v18 at rank 16", ("compositional", "e910409c3f2c")),
-    "soup-v11v12v13-270m": ("soup v11+v12+v13 (not shipped)", ("compositional", "9c33668eac7c")),
-    "soup-v7v8-270m": ("soup v7+v8 (shipped until 2026-11-23)",
-                       ("compositional", "6c3132045205")),
-    "soup-v7v8v10-270m": ("soup v7+v8+v10 (shipped until 2026-11-24)",
-                          ("compositional", "6c3132045205")),
-    "soup-v11v12-270m": ("soup v11+v12 (shipped until 2026-11-24)",
-                         ("compositional", "690d5d4a1e5f")),
-    "v16-shipped-270m": ("v16 (shipped until 2026-11-24)", ("compositional", "89be643cc979")),
-    "shipped-greedy": ("soup v16+v17 and its 3.7 warm start (shipped 2026-11-26)",
-                       ("compositional", "f7eb90893a26")),
-    "shipped-repair8": ("the same, as ara translate (2026-11-26)",
-                        ("compositional", "f7eb90893a26")),
-    "compositional-adapter-270m": ("soup v16+v17 (shipped until 2026-11-26)",
-                                   ("compositional", "89be643cc979")),
-}
+SHIPPED = Path(__file__).resolve().parents[1] / "eval" / "models"
 SETS = [*((suite, form) for suite in SUITES for form in ("lifted", "grounded")),
         ("compositional", "lifted"), ("compositional", "grounded"),
         ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
 VARIANTS = [("none", 0), ("C", 0), ("F+C", 5)]
+
+
+def trained_on(folder: Path, given: dict[str, tuple[str, str]], notes: list[str]
+               ) -> tuple[str, str] | None:
+    """(split, version) the model behind ``folder``'s runs trained on, None for none."""
+    if folder.name in given:
+        return given[folder.name]
+    run = json.loads(next(folder.glob("*/run.json")).read_text())
+    if "+lora:sha256:" not in run["model_id"]:
+        return None
+    digest = run["model_id"].rsplit("+lora:sha256:", 1)[1]
+    for record in sorted(SHIPPED.glob("*.json")):
+        shipped = json.loads(record.read_text())
+        if shipped.get("sha256", "").startswith(digest):
+            data = shipped["run"]["data"]
+            return data["split"], data["version"]
+    from ara.data import registered_version
+
+    version = registered_version("compositional")
+    notes.append(f"{folder.name}: an adapter not shipped here; 'unseen' assumes it trained "
+                 f"on compositional {version} (else pass --trained-on)")
+    return "compositional", version
 
 
 def training_sentences(trained_on: tuple[str, str] | None, notes: list[str]) -> set[str]:
@@ -167,7 +92,8 @@ def cell(samples: list[dict], seen: set[str]) -> dict:
     }
 
 
-def collect(results: Path, test_versions: dict[str, str] | None = None
+def collect(results: Path, models: list[str], test_versions: dict[str, str] | None = None,
+            given: dict[str, tuple[str, str]] | None = None
             ) -> tuple[dict, list[str], list[str]]:
     """The table, the runs left out because their test data is not the one chosen
     (``test_versions``: split -> version; the registered one otherwise), and notes."""
@@ -182,8 +108,8 @@ def collect(results: Path, test_versions: dict[str, str] | None = None
     stale: list[str] = []
     notes: list[str] = []
     current = {split: test_side(split) for split in {split for split, _ in SETS}}
-    for folder, (_, trained_on) in MODELS.items():
-        seen = training_sentences(trained_on, notes)
+    for folder in models:
+        seen = training_sentences(trained_on(results / folder, given or {}, notes), notes)
         for split, form in SETS:
             version, pairs = current[split]
             # A run on an earlier version of the test data keeps it in its folder name
@@ -205,9 +131,9 @@ def collect(results: Path, test_versions: dict[str, str] | None = None
     return table, stale, notes
 
 
-def markdown(table: dict) -> str:
-    names = [m for m in MODELS if any(m in row for row in table.values())]
-    head = "| set | form | variant | pairs | " + " | ".join(MODELS[m][0] for m in names) + " |"
+def markdown(table: dict, models: list[str]) -> str:
+    names = [m for m in models if any(m in row for row in table.values())]
+    head = "| set | form | variant | pairs | " + " | ".join(names) + " |"
     lines = [head, "|---|---|---|---:|" + "---:|" * len(names)]
     for split, form in SETS:
         for variant, shots in VARIANTS:
@@ -236,13 +162,25 @@ def main() -> None:
     parser.add_argument("--test", action="append", default=[], metavar="SPLIT=VERSION",
                         help="compare on this prepared version of a split's test side "
                              "(default: the registered one); repeatable")
+    parser.add_argument("--models", help="comma-separated folders of --results, in the "
+                        "table's order (default: every folder holding runs, sorted)")
+    parser.add_argument("--trained-on", action="append", default=[],
+                        metavar="NAME=SPLIT:VERSION",
+                        help="the data a model trained on, for 'unseen'; repeatable")
     args = parser.parse_args()
     try:
         test_versions = dict(item.split("=", 1) for item in args.test)
+        given = {name: tuple(data.split(":", 1)) for name, data in
+                 (item.split("=", 1) for item in args.trained_on)}
     except ValueError:
-        parser.error(f"--test takes SPLIT=VERSION, got {args.test}")
-    table, stale, notes = collect(args.results, test_versions)
-    print(markdown(table))
+        parser.error("--test takes SPLIT=VERSION and --trained-on NAME=SPLIT:VERSION")
+    found = sorted(p.parent.parent.name for p in args.results.glob("*/*/samples.jsonl"))
+    models = args.models.split(",") if args.models else list(dict.fromkeys(found))
+    missing = [m for m in models if m not in found]
+    if missing or not models:
+        parser.error(f"no runs under {args.results} for {missing or 'any model'}")
+    table, stale, notes = collect(args.results, models, test_versions, given)
+    print(markdown(table, models))
     print("\nCells: accuracy / validity in %; (unseen ...): accuracy on the pairs whose "
           "sentence is not in that model's training data.")
     if stale:
