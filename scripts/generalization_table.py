@@ -9,17 +9,17 @@ Each folder of ``--results`` holding runs is a model (``--models`` picks and ord
 them), its column headed by the folder's name.
 
 A cell is accuracy / validity in % over all pairs of the run (invalid and undecided
-answers count as wrong). ``unseen`` is the accuracy on the pairs whose sentence does
-not occur in that model's own training data: the version a shipped adapter's record in
+answers count as wrong). ``unseen`` is the accuracy on the pairs whose sentence does not
+occur in that model's own training data: the version a shipped adapter's record in
 ``eval/models/`` names (found by the adapter's hash in the run's model id), the one
-``--trained-on`` gives, else for an adapter the registered compositional mixture and
-for the base model nothing (the output says which it assumed), the figure that says what a user's new sentence can expect; the paper split's
-lifted test side is almost all seen. A run whose pairs are not all pairs of the test
-data (the registered version, or the one ``--test SPLIT=VERSION`` names) is left out
-and listed: the timed dev file's labels were corrected in timed version 5f389aa2c4b4,
-and each version of the compositional mixture has its own test side (a run on an
-earlier one lives in ``<set>-<form>@<version>``). Writes ``summary.json`` beside the
-runs.
+``--trained-on`` gives, else for an adapter the registered compositional mixture and for
+any other model nothing (the output says which it assumed), the figure that says what a
+user's new sentence can expect; the paper split's lifted test side is almost all seen. A
+run whose pairs are not all pairs of the test data (the registered version, or the one
+``--test SPLIT=VERSION`` names) is left out and listed: the timed dev file's labels were
+corrected in timed version 5f389aa2c4b4, and each version of the compositional mixture
+has its own test side (a run on an earlier one lives in ``<set>-<form>@<version>``).
+Writes ``summary.json`` beside the runs.
 """
 
 from __future__ import annotations
@@ -48,6 +48,8 @@ def trained_on(folder: Path, given: dict[str, tuple[str, str]], notes: list[str]
         return given[folder.name]
     run = json.loads(next(folder.glob("*/run.json")).read_text())
     if "+lora:sha256:" not in run["model_id"]:
+        notes.append(f"{folder.name}: no adapter in its model id; 'unseen' assumes it trained "
+                     "on nothing (else pass --trained-on)")
         return None
     digest = run["model_id"].rsplit("+lora:sha256:", 1)[1]
     for record in sorted(SHIPPED.glob("*.json")):
@@ -172,6 +174,8 @@ def main() -> None:
         test_versions = dict(item.split("=", 1) for item in args.test)
         given = {name: tuple(data.split(":", 1)) for name, data in
                  (item.split("=", 1) for item in args.trained_on)}
+        if any(len(data) != 2 for data in given.values()):
+            raise ValueError
     except ValueError:
         parser.error("--test takes SPLIT=VERSION and --trained-on NAME=SPLIT:VERSION")
     found = sorted(p.parent.parent.name for p in args.results.glob("*/*/samples.jsonl"))

@@ -381,11 +381,17 @@ def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
 
 
 def _log_summary(path: Path) -> dict:
-    """The first loss and the seconds spent in steps, over every session of the run: a
+    """The first and last loss and the seconds spent in steps, over every session of the run: a
     session killed outright records no wall time of its own, but its steps are logged
     (a step redone after a resume counts again, as the time was spent)."""
-    rows = [json.loads(line) for line in path.read_text().splitlines()] if path.is_file() else []
+    rows = []
+    for line in path.read_text().splitlines() if path.is_file() else ():
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError:  # the half-written line of a session killed mid-write
+            continue
     return {"first_loss": rows[0]["loss"] if rows else None,
+            "last_loss": rows[-1]["loss"] if rows else None,
             "step_seconds": round(sum(r["seconds"] for r in rows), 1)}
 
 
@@ -393,10 +399,9 @@ def run_training(config: TrainConfig, resume: bool = False) -> dict:
     """Train, save the adapter, run the held-out check; returns a summary."""
     recipe = LoRAFinetuneRecipe(config, resume)
     recipe.setup()
-    losses = recipe.train()
+    recipe.train()
     recipe.save_checkpoint()
-    summary = {"steps": recipe.step, **_log_summary(recipe.out / "train_log.jsonl"),
-               "last_loss": losses[-1] if losses else None}
+    summary = {"steps": recipe.step, **_log_summary(recipe.out / "train_log.jsonl")}
     if recipe.accelerator.is_main_process:  # one adapter and one check, whatever the processes
         summary["adapter"] = str(recipe.save_adapter())
         if config.eval_pairs:

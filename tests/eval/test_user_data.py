@@ -190,7 +190,8 @@ def test_the_tables_name_the_test_file_not_the_examples_file():
 
     meta = {"config": {"data": "data/examples/lab-test.jsonl",
                        "examples": "data/examples/lab-pairs.jsonl"},
-            "data_files": {"data/examples/lab-pairs.jsonl": "bb", "data/examples/lab-test.jsonl": "77"},
+            "data_files": {"data/examples/lab-pairs.jsonl": "bb",
+                           "data/examples/lab-test.jsonl": "77"},
             "data": {"split": "file"}}
     assert data_name(meta) == "lab-test.jsonl"
     assert data_name({"config": {}, "data": {"split": "paper"}}) == "paper"
