@@ -33,8 +33,8 @@ from datetime import date
 from pathlib import Path
 
 from ara.data.handwritten import SUITES
+from ara.eval.translate.models import SHIPPED
 
-SHIPPED = Path(__file__).resolve().parents[1] / "eval" / "models"
 SETS = [*((suite, form) for suite in SUITES for form in ("lifted", "grounded")),
         ("compositional", "lifted"), ("compositional", "grounded"),
         ("timed", "lifted"), ("paper", "lifted"), ("disjoint", "lifted")]
