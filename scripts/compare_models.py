@@ -70,7 +70,7 @@ def main() -> None:
 
 def ceilings(results: Path) -> str:
     """What the labels allow on each split's sample (see `ara eval ceiling`)."""
-    from ara.data import load_or_prepare
+    from ara.data import load_split
     from ara.eval.ceiling import split_ceiling
 
     lines = []
@@ -78,9 +78,11 @@ def ceilings(results: Path) -> str:
         run = results / f"base-270m-{split}-zeroshot" / "run.json"
         if not run.exists():
             continue
-        c = json.loads(run.read_text())["config"]
-        ceiling = split_ceiling(load_or_prepare(split, c["data_seed"]), c["form"], c["limit"],
-                                c["seed"])
+        record = json.loads(run.read_text())
+        c = record["config"]
+        # The ceiling of the data the run was judged on, which a later version may not be.
+        data = load_split(split, c["data_seed"], version=record["data"]["version"])
+        ceiling = split_ceiling(data, c["form"], c["limit"], c["seed"])
         lines.append(f"{split}: a translator that follows the training labels can get at most "
                      f"{ceiling.train_majority}/{ceiling.records} of these pairs right "
                      f"({len(ceiling.conflicts)} inputs are labelled otherwise in training).")
