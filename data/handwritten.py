@@ -19,7 +19,10 @@ answered it, and is never read to guide anything; ``handwritten/suite6.yaml``
 operations, security patrol) was written blind on 2026-11-27 by the same rules;
 ``handwritten/suite7.yaml`` (split ``handwritten7``, 147 entries: solar and wind farm
 maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfire and
-forestry) was written blind on 2026-11-27 by the same rules.
+forestry) was written blind on 2026-11-27 by the same rules; ``handwritten/suite8.yaml``
+(split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
+and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
+the same rules, to judge the change after the one suite 7 judges.
 """
 
 from __future__ import annotations
@@ -40,10 +43,11 @@ SUITE4 = Path(__file__).parent / "handwritten" / "suite4.yaml"
 SUITE5 = Path(__file__).parent / "handwritten" / "suite5.yaml"
 SUITE6 = Path(__file__).parent / "handwritten" / "suite6.yaml"
 SUITE7 = Path(__file__).parent / "handwritten" / "suite7.yaml"
+SUITE8 = Path(__file__).parent / "handwritten" / "suite8.yaml"
 #: Each hand-written split and its file; a split's records carry its name as source.
 SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3,
           "handwritten4": SUITE4, "handwritten5": SUITE5, "handwritten6": SUITE6,
-          "handwritten7": SUITE7}
+          "handwritten7": SUITE7, "handwritten8": SUITE8}
 
 
 @dataclass(frozen=True)
@@ -60,7 +64,8 @@ class SuiteEntry:
             ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth);
             ``lifted``, ``retail``, ``mining``, ``marine``, ``airport`` or ``security``
             (the sixth); ``lifted``, ``energy``, ``rail``, ``hotel``, ``delivery`` or
-            ``forestry`` (the seventh).
+            ``forestry`` (the seventh); ``lifted``, ``aquaculture``, ``library``,
+            ``venue``, ``water`` or ``snow`` (the eighth).
     """
 
     nl: str
