@@ -36,18 +36,13 @@ from ara.data.normalize import Record, UidMaker, form_of
 from ara.errors import ConfigError
 from ara.grammars import atoms, parse, to_text
 
-SUITE = Path(__file__).parent / "handwritten" / "suite.yaml"
-SUITE2 = Path(__file__).parent / "handwritten" / "suite2.yaml"
-SUITE3 = Path(__file__).parent / "handwritten" / "suite3.yaml"
-SUITE4 = Path(__file__).parent / "handwritten" / "suite4.yaml"
-SUITE5 = Path(__file__).parent / "handwritten" / "suite5.yaml"
-SUITE6 = Path(__file__).parent / "handwritten" / "suite6.yaml"
-SUITE7 = Path(__file__).parent / "handwritten" / "suite7.yaml"
-SUITE8 = Path(__file__).parent / "handwritten" / "suite8.yaml"
-#: Each hand-written split and its file; a split's records carry its name as source.
-SUITES = {"handwritten": SUITE, "handwritten2": SUITE2, "handwritten3": SUITE3,
-          "handwritten4": SUITE4, "handwritten5": SUITE5, "handwritten6": SUITE6,
-          "handwritten7": SUITE7, "handwritten8": SUITE8}
+FOLDER = Path(__file__).parent / "handwritten"
+#: Each hand-written split and its file (``suite.yaml`` is ``handwritten``, ``suite2.yaml``
+#: ``handwritten2``, ...); a split's records carry its name as source. A new suite is a
+#: new file here, registered with ``ara data prepare --split NAME``.
+SUITES = {"handwritten" + p.stem.removeprefix("suite"): p
+          for p in sorted(FOLDER.glob("suite*.yaml"),
+                          key=lambda p: int(p.stem.removeprefix("suite") or 1))}
 
 
 @dataclass(frozen=True)
@@ -82,7 +77,7 @@ class SuiteEntry:
         return form_of(self.aps)
 
 
-def load_suite(path: Path = SUITE) -> list[SuiteEntry]:
+def load_suite(path: Path = SUITES["handwritten"]) -> list[SuiteEntry]:
     """The suite's entries, with every formula parsed and printed canonically.
 
     Raises:
