@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 
-from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, HAPPENS, HOLDS
+from ara.grammars.nesting import AFTER_WINDOW, AGAIN_AND_AGAIN, FOR_GOOD, HAPPENS, HOLDS
 
 #: Numbers a sentence may write in words.
 NUMBER_WORDS = {w: i for i, w in enumerate(
@@ -24,7 +24,8 @@ TIME_WORDS = frozenset("step steps time second seconds minute minutes hour hours
 
 #: Words that allow ``G(F(a))``: a again and again.
 AGAIN_AND_AGAIN_WORDS = re.compile(
-    r"\b(again|repeatedly|over and over|time and again|infinitely|often|periodic\w*"
+    r"\b(again|repeatedly|over and over|time and again|time after time|infinitely|often"
+    r"|periodic\w*"
     r"|regularly|every so often|now and then|from time to time|always eventually"
     r"|keep (?:on )?(?:visiting|revisiting|coming|returning|going|checking|patrolling"
     r"|circling|cycling)|back and forth|patrol\w*|alternat\w*|recurr\w*|endless\w*"
@@ -37,7 +38,8 @@ FOR_GOOD_WORDS = re.compile(
     rf"\b({_LASTING}|stay|stays|staying"
     r"|from (?:then|now|there) on|from (?:that|this|the|some) (?:moment|point|time|step) on"
     r"|eventually always|thereafter|ever after|onwards?|henceforth|indefinitely|in the end"
-    r"|ultimately|ends? up|settles?|continu\w*"
+    r"|ultimately|ends? up|settles?|continu\w*|leave (?:it|them) (?:there|in place)"
+    r"|never\b[\w ]* again"
     r"|uninterrupted\w*|consecutive\w*|consistently|(?:until|till) the (?:very )?end)\b")
 #: Words that order steps: "go to the dock, then charge". A ", then" after a condition
 #: ("if a, then b") orders nothing, nor does "sooner or later".
@@ -67,7 +69,7 @@ HAPPENS_WORDS = re.compile(
 #: Words that ask for something again and again (:data:`AGAIN_AND_AGAIN`), a strict
 #: part of :data:`AGAIN_AND_AGAIN_WORDS`: each of these says it, not only allows it.
 RECURRING_WORDS = re.compile(
-    r"\b(again and again|repeatedly|over and over|time and again|infinitely often"
+    r"\b(again and again|repeatedly|over and over|time (?:and|after) again|infinitely often"
     r"|every so often|now and then|from time to time|periodically|regularly"
     r"|keep (?:on )?(?:visiting|revisiting|coming back|returning|going back|checking"
     r"|patrolling|circling|cycling)|patrol\w*|back and forth"
@@ -75,8 +77,11 @@ RECURRING_WORDS = re.compile(
 
 #: The words that ask for each temporal claim, in the order claims are reported.
 CLAIM_WORDS = {HOLDS: HOLDS_WORDS, HAPPENS: HAPPENS_WORDS, AGAIN_AND_AGAIN: RECURRING_WORDS}
-#: The words that allow each nested pair of ``F`` and ``G``.
-NESTING_WORDS = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS}
+#: The words that allow each nested pair of ``F`` and ``G``: ``G[0,5](F(a))`` only where
+#: the sentence says a happens at some point ("for every moment of the next 5, at some
+#: point later a", as NL2TL's timed rows put it).
+NESTING_WORDS = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS,
+                 AFTER_WINDOW: HAPPENS_WORDS}
 
 
 def says_in_order(text: str) -> bool:

@@ -2,7 +2,9 @@
 formulas order steps in time.
 
 ``F`` and ``G`` nested one in the other say something that needs words of its own:
-``G(F(a))`` "a again and again", ``F(G(a))`` "a from some point on, for good". The same
+``G(F(a))`` "a again and again", ``F(G(a))`` "a from some point on, for good",
+``G[0,45](F(a))`` "at every step of the first 45, a at some point later", which is no
+more than ``F[45,inf)(a)`` and is what a slip gives for "keep a on for 45 minutes". The same
 operator nested in itself, with one of the two unbounded, says no more than one of
 them would (``F(F(a))`` is ``F(a)``, ``G(G(a))`` is ``G(a)``) or makes a bound void
 (``F[10,25](F(a))`` is ``F[10,inf)(a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
@@ -41,6 +43,7 @@ from ara.grammars.ast import (
 #: The nested pairs :func:`nested_pairs` names: an operator over another, unbounded.
 AGAIN_AND_AGAIN = "G(F)"
 FOR_GOOD = "F(G)"
+AFTER_WINDOW = "G[a,b](F)"
 RESTATED = "restated"
 #: What :func:`temporal_claims` names besides :data:`AGAIN_AND_AGAIN`.
 HOLDS = "G"
@@ -53,7 +56,8 @@ def nested_pairs(formula: Formula) -> Iterator[tuple[Formula, str]]:
 
     - :data:`RESTATED`: the same operator twice, one of them unbounded;
     - :data:`AGAIN_AND_AGAIN`: an unbounded ``G`` over an unbounded ``F``;
-    - :data:`FOR_GOOD`: an ``F`` (bounded or not) over an unbounded ``G``.
+    - :data:`FOR_GOOD`: an ``F`` (bounded or not) over an unbounded ``G``;
+    - :data:`AFTER_WINDOW`: a ``G`` bounded at both ends over an unbounded ``F``.
 
     Other pairs (``G(F[0,10](a))`` "at least once in every 10 steps", ``F(G[0,5](a))``
     "at some point, a for 5 steps", both bounded) are left out: each says what its
@@ -70,6 +74,8 @@ def nested_pairs(formula: Formula) -> Iterator[tuple[Formula, str]]:
                 yield node, RESTATED
         elif inner.interval is None and (isinstance(node, Eventually) or node.interval is None):
             yield node, FOR_GOOD if isinstance(node, Eventually) else AGAIN_AND_AGAIN
+        elif inner.interval is None and node.interval.hi is not None:
+            yield node, AFTER_WINDOW
 
 
 def sequenced_steps(formula: Formula) -> Iterator[Formula]:

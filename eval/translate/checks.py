@@ -31,6 +31,7 @@ from ara.grammars.literal_edits import (
     unchained,
 )
 from ara.grammars.nesting import (
+    AFTER_WINDOW,
     AGAIN_AND_AGAIN,
     FOR_GOOD,
     HAPPENS,
@@ -44,7 +45,8 @@ from ara.grammars.nesting import (
 from ara.grammars.printer import to_text
 
 _SAYS = {AGAIN_AND_AGAIN: "again and again", FOR_GOOD: "from some point on, for good",
-         RESTATED: "an operator inside the same one"}
+         RESTATED: "an operator inside the same one",
+         AFTER_WINDOW: "at some point from the window's end on"}
 _CLAIMS = {HOLDS: "that anything holds over time (G)",
            HAPPENS: "that anything happens at some point (F)",
            AGAIN_AND_AGAIN: "that anything happens again and again (G(F))"}
@@ -80,9 +82,9 @@ class Check:
 
 def unasked(request: Request, formula: Formula) -> tuple[Formula, ...]:
     """The parts of ``formula`` its request never asks for: nested pairs that restate an
-    operator, ``G(F)`` or ``F(G)`` where the sentence has none of the words for it, and
-    steps put one after another (:func:`~ara.grammars.nesting.sequenced_steps`) where it
-    says "in any order"."""
+    operator, ``G(F)``, ``F(G)`` or ``G[a,b](F)`` where the sentence has none of the
+    words for it, and steps put one after another
+    (:func:`~ara.grammars.nesting.sequenced_steps`) where it says "in any order"."""
     pairs = [node for node, kind in nested_pairs(formula)
              if kind == RESTATED or kind not in request.allows]
     ordered = list(sequenced_steps(formula)) if request.any_order else []

@@ -63,6 +63,28 @@ def test_words_for_a_pair_license_it_and_a_restated_operator_never_is():
     assert not _gaps(nl, ["prop_1"], "F[10,25](prop_1)")
 
 
+def test_a_window_over_an_unbounded_f_is_asked_for_only_with_words_that_it_happens():
+    """Tests that "keep the oven on for 45 minutes" asks for no ``G[0,45](F(...))``, and
+    that dropping its ``F`` mends it, while NL2TL's wording of that formula asks for it."""
+    keep = Request.of("Keep the oven on for 45 minutes.", ["oven_on"])
+    answer = parse("G[0,45](F(oven_on))")
+    assert [to_text(f) for f in unasked(keep, answer)] == ["G[0,45](F(oven_on))"]
+    assert "G[0,45](oven_on)" in map(to_text, mends(keep, answer))
+    nl2tl = ("for every moment within the next 0 to 5 time units, there must be sometime "
+             "in the future that (prop_1)")
+    assert not _gaps(nl2tl, ["prop_1"], "G[0,5](F(prop_1))")
+
+
+def test_plain_words_for_staying_and_recurring_license_their_pairs():
+    """Tests that "leave it there" and "never ... again" allow for good, "time after
+    time" again and again."""
+    assert not _gaps("Park the cart in bay 2 and leave it there.", ["cart_in_bay_2"],
+                     "F(G(cart_in_bay_2))")
+    assert not _gaps("Lock the hatch and never open it again.", ["hatch_open"],
+                     "F(G(!hatch_open))")
+    assert not _gaps("Check the pump, time after time.", ["check_pump"], "G(F(check_pump))")
+
+
 def test_generated_sentences_never_ask_for_less_than_their_formula_says():
     """Tests that no realized sentence reads as not asking for its formula's nesting or
     order: repair must not undo what the model learned from them."""

@@ -3,6 +3,7 @@
 from ara.grammars import parse, to_text
 from ara.grammars.literal_edits import chained, operator_drops, unchained
 from ara.grammars.nesting import (
+    AFTER_WINDOW,
     AGAIN_AND_AGAIN,
     FOR_GOOD,
     HAPPENS,
@@ -35,6 +36,15 @@ def test_an_operator_inside_the_same_one_restates_it_or_voids_a_bound():
     for stl in ("F(F(a))", "G(G(a))", "F[10,25](F(a))", "G(G[0,5](a))"):
         assert [kind for _, kind in pairs(stl)] == [RESTATED], stl
     assert equivalent(parse("F[10,25](F(a))"), parse("F[10,25](a) | F[25,inf](a)"))
+
+
+def test_a_window_of_g_over_an_unbounded_f_says_only_a_late_f():
+    """"At every step of the first 45, a at some point later" asks no more than a at
+    some point from step 45 on; a slip for "keep a on for 45 minutes" writes it."""
+    assert pairs("G[0,45](F(a))") == [("G[0,45](F(a))", AFTER_WINDOW)]
+    assert equivalent(parse("G[0,45](F(a))"), parse("F[45,inf](a)"))
+    # from step 5 on, a again and again: no window to void
+    assert pairs("G[5,inf](F(a))") == []
 
 
 def test_dropping_either_operator_of_a_pair():
