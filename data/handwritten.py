@@ -22,7 +22,8 @@ maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfir
 forestry) was written blind on 2026-11-27 by the same rules; ``handwritten/suite8.yaml``
 (split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
 and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
-the same rules, to judge the change after the one suite 7 judges.
+the same rules; it judged repair's window check (``G[a,b](F)``) that day, while suite 7
+waits for the recipe's second run.
 """
 
 from __future__ import annotations
