@@ -23,7 +23,10 @@ forestry) was written blind on 2026-11-27 by the same rules; ``handwritten/suite
 (split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
 and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
 the same rules; it judged repair's window check (``G[a,b](F)``) that day, while suite 7
-waits for the recipe's second run.
+waits for the recipe's second run; ``handwritten/suite9.yaml`` (split ``handwritten9``,
+149 entries: data centers and server rooms, film and TV sets, car washes and vehicle
+service bays, zoos and animal care, recycling and waste sorting plants) was written blind
+on 2026-11-27 by the same rules, to judge the change after the recipe's second run.
 """
 
 from __future__ import annotations
@@ -61,7 +64,8 @@ class SuiteEntry:
             ``lifted``, ``retail``, ``mining``, ``marine``, ``airport`` or ``security``
             (the sixth); ``lifted``, ``energy``, ``rail``, ``hotel``, ``delivery`` or
             ``forestry`` (the seventh); ``lifted``, ``aquaculture``, ``library``,
-            ``venue``, ``water`` or ``snow`` (the eighth).
+            ``venue``, ``water`` or ``snow`` (the eighth); ``lifted``, ``datacenter``,
+            ``film``, ``carwash``, ``zoo`` or ``recycling`` (the ninth).
     """
 
     nl: str
