@@ -31,6 +31,7 @@ on 2026-11-27 by the same rules, to judge the change after the recipe's second r
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,9 +45,13 @@ FOLDER = Path(__file__).parent / "handwritten"
 #: Each hand-written split and its file (``suite.yaml`` is ``handwritten``, ``suite2.yaml``
 #: ``handwritten2``, ...); a split's records carry its name as source. A new suite is a
 #: new file here, registered with ``ara data prepare --split NAME``.
-SUITES = {"handwritten" + p.stem.removeprefix("suite"): p
-          for p in sorted(FOLDER.glob("suite*.yaml"),
-                          key=lambda p: int(p.stem.removeprefix("suite") or 1))}
+_NAMED = sorted(filter(None, (re.fullmatch(r"suite([2-9]|[1-9]\d+)?", p.stem)
+                              for p in FOLDER.glob("suite*.yaml"))),
+                key=lambda m: int(m[1] or 1))
+SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
+#: Blind suites no model has answered yet, and the change each waits to judge: scripts
+#: that run "every suite" by default leave them out until they are named.
+WAITING = {"handwritten7": "the recipe's second run", "handwritten9": "the change after it"}
 
 
 @dataclass(frozen=True)

@@ -38,8 +38,9 @@ FOR_GOOD_WORDS = re.compile(
     rf"\b({_LASTING}|stay|stays|staying"
     r"|from (?:then|now|there) on|from (?:that|this|the|some) (?:moment|point|time|step) on"
     r"|eventually always|thereafter|ever after|onwards?|henceforth|indefinitely|in the end"
-    r"|ultimately|ends? up|settles?|continu\w*|leave (?:it|them) (?:there|in place)"
-    r"|never\b[\w ]* again"
+    r"|ultimately|ends? up|settles?|continu\w*"
+    r"|(?<!not )(?<!n't )leave (?:it|them) (?:there|in place)"
+    r"|never(?: (?!and\b|then\b|or\b)[\w']+){1,4} again(?! and again)"
     r"|uninterrupted\w*|consecutive\w*|consistently|(?:until|till) the (?:very )?end)\b")
 #: Words that order steps: "go to the dock, then charge". A ", then" after a condition
 #: ("if a, then b") orders nothing, nor does "sooner or later".
@@ -69,7 +70,8 @@ HAPPENS_WORDS = re.compile(
 #: Words that ask for something again and again (:data:`AGAIN_AND_AGAIN`), a strict
 #: part of :data:`AGAIN_AND_AGAIN_WORDS`: each of these says it, not only allows it.
 RECURRING_WORDS = re.compile(
-    r"\b(again and again|repeatedly|over and over|time (?:and|after) again|infinitely often"
+    r"\b(again and again|repeatedly|over and over|time and again|time after time"
+    r"|infinitely often"
     r"|every so often|now and then|from time to time|periodically|regularly"
     r"|keep (?:on )?(?:visiting|revisiting|coming back|returning|going back|checking"
     r"|patrolling|circling|cycling)|patrol\w*|back and forth"
@@ -79,7 +81,8 @@ RECURRING_WORDS = re.compile(
 CLAIM_WORDS = {HOLDS: HOLDS_WORDS, HAPPENS: HAPPENS_WORDS, AGAIN_AND_AGAIN: RECURRING_WORDS}
 #: The words that allow each nested pair of ``F`` and ``G``: ``G[0,5](F(a))`` only where
 #: the sentence says a happens at some point ("for every moment of the next 5, at some
-#: point later a", as NL2TL's timed rows put it).
+#: point later a", as NL2TL's timed rows put it). Like the others, a word anywhere in
+#: the sentence allows it, even one about another proposition: the check stays one-sided.
 NESTING_WORDS = {AGAIN_AND_AGAIN: AGAIN_AND_AGAIN_WORDS, FOR_GOOD: FOR_GOOD_WORDS,
                  AFTER_WINDOW: HAPPENS_WORDS}
 

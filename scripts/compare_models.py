@@ -70,7 +70,7 @@ def main() -> None:
 
 def ceilings(results: Path) -> str:
     """What the labels allow on each split's sample (see `ara eval ceiling`)."""
-    from ara.data import load_split
+    from ara.data import load_or_prepare, load_split, registered_version
     from ara.eval.ceiling import split_ceiling
 
     lines = []
@@ -81,7 +81,11 @@ def ceilings(results: Path) -> str:
         record = json.loads(run.read_text())
         c = record["config"]
         # The ceiling of the data the run was judged on, which a later version may not be.
-        data = load_split(split, c["data_seed"], version=record["data"]["version"])
+        version = record.get("data", {}).get("version")
+        if version in (None, registered_version(split, c["data_seed"])):
+            data = load_or_prepare(split, c["data_seed"])
+        else:  # raises, naming the version, where this machine never prepared it
+            data = load_split(split, c["data_seed"], version=version)
         ceiling = split_ceiling(data, c["form"], c["limit"], c["seed"])
         lines.append(f"{split}: a translator that follows the training labels can get at most "
                      f"{ceiling.train_majority}/{ceiling.records} of these pairs right "

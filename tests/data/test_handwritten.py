@@ -8,6 +8,7 @@ import pytest
 
 from ara.data.handwritten import (
     SUITES,
+    WAITING,
     load_suite,
     suite_records,
 )
@@ -73,6 +74,14 @@ def test_no_suite_sentence_occurs_in_any_training_source(suite):
                 if row.get(field):
                     seen.add(_norm(" ".join(row[field])))
     assert [e.nl for e in entries if _norm(e.nl) in seen] == []
+
+
+def test_suites_are_found_by_file_in_order_and_the_waiting_ones_are_among_them():
+    names = list(SUITES)
+    assert names[:3] == ["handwritten", "handwritten2", "handwritten3"]
+    assert names == sorted(names, key=lambda n: int(n.removeprefix("handwritten") or 1))
+    assert all(SUITES[n].name == f"suite{n.removeprefix('handwritten')}.yaml" for n in names)
+    assert set(WAITING) <= set(SUITES)
 
 
 def test_each_suite_repeats_no_sentence_of_an_earlier_one():

@@ -83,6 +83,11 @@ def test_plain_words_for_staying_and_recurring_license_their_pairs():
     assert not _gaps("Lock the hatch and never open it again.", ["hatch_open"],
                      "F(G(!hatch_open))")
     assert not _gaps("Check the pump, time after time.", ["check_pump"], "G(F(check_pump))")
+    assert _gaps("Check the pump, time after time.", ["check_pump"], "G(check_pump)").claims
+    # neither across a clause nor negated
+    for nl in ("Never enter the lab and visit the dock again and again.",
+               "Do not leave it there: park the cart in bay 2."):
+        assert "F(G)" not in Request.of(nl, ()).allows, nl
 
 
 def test_generated_sentences_never_ask_for_less_than_their_formula_says():

@@ -43,7 +43,8 @@ def test_a_window_of_g_over_an_unbounded_f_says_only_a_late_f():
     some point from step 45 on; a slip for "keep a on for 45 minutes" writes it."""
     assert pairs("G[0,45](F(a))") == [("G[0,45](F(a))", AFTER_WINDOW)]
     assert equivalent(parse("G[0,45](F(a))"), parse("F[45,inf](a)"))
-    # from step 5 on, a again and again: no window to void
+    assert pairs("G[5,10](F(a))") == [("G[5,10](F(a))", AFTER_WINDOW)]
+    # an open window (the decoding grammar writes none) is not this kind
     assert pairs("G[5,inf](F(a))") == []
 
 
