@@ -6,10 +6,10 @@ right and how many wrong.
 
     .venv/bin/python scripts/gap_precision.py [--run RUN] [--variant C] [--json] [--show N]
 
-Sets: the first four hand-written suites and the sixth (not the fifth, nor those from
-the seventh on: blind judges, past or waiting), the compositional test side, NL2TL's timed dev file, the paper split's test side, and the
-compositional training mixture (whose NL2TL labels are noisy). Kinds:
-:data:`ara.eval.translate.checks.KINDS`.
+Sets: the first four hand-written suites and the sixth (not the fifth, nor those from the
+seventh on: blind judges, past or waiting), the compositional test side, NL2TL's timed dev
+file, the paper split's test side, and the compositional training mixture (whose NL2TL
+labels are noisy). Kinds: :data:`ara.eval.translate.checks.KINDS`.
 """
 
 from __future__ import annotations
