@@ -6,7 +6,7 @@ from ara.data.synthetic import synthetic_records
 from ara.eval.translate.checks import CHECKS, KINDS, Gaps, gaps, mends, unasked, unclaimed
 from ara.eval.translate.request import Request
 from ara.grammars import parse, to_text
-from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, RESTATED, nested_pairs
+from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, HAPPENS, HOLDS, RESTATED, nested_pairs
 
 
 def _gaps(nl, aps, stl):
@@ -87,7 +87,7 @@ def test_plain_words_for_staying_and_recurring_license_their_pairs():
     # neither across a clause nor negated
     for nl in ("Never enter the lab and visit the dock again and again.",
                "Do not leave it there: park the cart in bay 2."):
-        assert "F(G)" not in Request.of(nl, ()).allows, nl
+        assert FOR_GOOD not in Request.of(nl, ()).allows, nl
 
 
 def test_generated_sentences_never_ask_for_less_than_their_formula_says():
