@@ -20,7 +20,8 @@ from ara.grammars.spot_bridge import equivalent
 #: The least each suite holds: entries, and entries with a time bound.
 SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15),
          "handwritten4": (150, 60), "handwritten5": (120, 40), "handwritten6": (125, 45),
-         "handwritten7": (130, 50), "handwritten8": (135, 55), "handwritten9": (140, 55)}
+         "handwritten7": (130, 50), "handwritten8": (135, 55), "handwritten9": (140, 55),
+         "handwritten10": (140, 55)}
 #: Each suite's domains: from the fourth on, grounded ones no earlier suite covers.
 FIRST_DOMAINS = {"lifted", "navigation", "manipulation", "warehouse"}
 DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
@@ -31,7 +32,9 @@ DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
            "handwritten6": {"lifted", "retail", "mining", "marine", "airport", "security"},
            "handwritten7": {"lifted", "energy", "rail", "hotel", "delivery", "forestry"},
            "handwritten8": {"lifted", "aquaculture", "library", "venue", "water", "snow"},
-           "handwritten9": {"lifted", "datacenter", "film", "carwash", "zoo", "recycling"}}
+           "handwritten9": {"lifted", "datacenter", "film", "carwash", "zoo", "recycling"},
+           "handwritten10": {"lifted", "eldercare", "substation", "themepark", "laundry",
+                             "bridge"}}
 
 
 @pytest.fixture(scope="module", params=sorted(SUITES))
