@@ -211,6 +211,22 @@ def atoms_read_now(node: Formula) -> frozenset[str]:
     return frozenset().union(*(atoms_read_now(c) for c in children(node)))
 
 
+def signed_atoms(node: Formula, negated: bool = False) -> frozenset[tuple[str, bool]]:
+    """The propositions of ``node``, each with whether it occurs negated: under an odd
+    number of negations, an implication's premise counting as one (``a -> !b`` gives
+    ``(a, True)`` and ``(b, True)``); under ``<->``, with both signs."""
+    if isinstance(node, Atom):
+        return frozenset({(node.name, negated)})
+    if isinstance(node, Not):
+        return signed_atoms(node.arg, not negated)
+    if isinstance(node, Implies):
+        return signed_atoms(node.lhs, not negated) | signed_atoms(node.rhs, negated)
+    if isinstance(node, Iff):
+        return frozenset().union(*(signed_atoms(c, n) for c in children(node)
+                                   for n in (negated, not negated)))
+    return frozenset().union(*(signed_atoms(c, negated) for c in children(node)))
+
+
 def interval_of(node: Formula) -> Interval | None:
     """The node's interval, or ``None`` for untimed and non-temporal nodes."""
     return getattr(node, "interval", None)

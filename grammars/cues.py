@@ -50,6 +50,37 @@ SEQUENCE_WORDS = re.compile(
 THEN = re.compile(r"[,;] then\b")
 CONDITION_WORDS = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|provided"
                              r"|as soon as|once|while|on condition|every ?time|each time)\b")
+#: Words that open a condition: what the clause after them names is read before the
+#: arrow ("whenever the bin is full, empty it": ``G(bin_full -> F(empty_bin))``).
+#: "When possible" is NL2TL's "at some point", "once every" a rate, "while" after a
+#: comma often a contrast.
+CONDITION_CLAUSE = re.compile(
+    r"\b(?<!even )(?<!as )(whenever|if|when|each time|every ?time|once|as soon as"
+    r"|(?<![,;] )while|as long as|in case|in the event(?: that| of)?|provided(?: that)?)\b"
+    r"(?! possible| (?:every|more|in a while|again|and only)\b)")
+#: Sentences whose condition words do not say which side is the condition: "a only if
+#: b" and "unless" turn it round, "a means that b" puts it first, "if and only if"
+#: puts it on both sides, and "at once", "at least once" name no condition.
+NO_CONDITION_CLAUSE = re.compile(
+    r"\b(only|unless|except|means|infers?|implies|if and only if|iff|at once"
+    r"|(?:at least|more than|exactly) once)\b")
+#: What ends a condition clause ("if the door opens, stop").
+_CLAUSE_END = re.compile(r"[,;.:!?]| then\b")
+
+
+def condition_clauses(text: str) -> list[tuple[int, int]]:
+    """The spans of ``text`` (lower case) that name a condition: each from a word of
+    :data:`CONDITION_CLAUSE` to the next comma or "then", none where the sentence's
+    words leave the direction open (:data:`NO_CONDITION_CLAUSE`)."""
+    if NO_CONDITION_CLAUSE.search(text):
+        return []
+    spans = []
+    for m in CONDITION_CLAUSE.finditer(text):
+        end = _CLAUSE_END.search(text, m.end())
+        spans.append((m.end(), end.start() if end else len(text)))
+    return spans
+
+
 #: Words that ask for no order between steps.
 ANY_ORDER_WORDS = re.compile(
     r"\b(in (?:any|either|whatever|whichever) order|(?:the )?order does not matter"

@@ -36,6 +36,8 @@ from ara.grammars.ast import (
     atoms,
     children,
     conjuncts,
+    map_children,
+    walk,
     with_children,
 )
 from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, is_temporal
@@ -145,6 +147,56 @@ def unchained(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
                 _add(out, rebuild(parts[0] if len(parts) == 1 else And(tuple(parts))))
     out.pop(to_text(formula), None)
     return list(out.values())
+
+
+def swapped(formula: Formula, nodes: Sequence[Formula], names: frozenset[str]) -> list[Formula]:
+    """Every formula with a literal of a premise and one of ``names`` in the consequence
+    of an implication of ``nodes`` trading places: ``G(at_door -> F(bell))`` becomes
+    ``G(bell -> F(at_door))`` (a condition read as the consequence), ``G(!running ->
+    guard_off)`` becomes ``G(guard_off -> !running)``. A negation stays with its
+    proposition: renaming alone would give ``G(!guard_off -> running)``, the
+    contrapositive of the answer, which says the same.
+
+    Returns:
+        Distinct formulas (by canonical text), in a fixed order, ``formula`` excluded.
+    """
+    out: dict[str, Formula] = {}
+    targets = set(nodes)
+    for sub, rebuild in _spots(formula):
+        if sub not in targets or not isinstance(sub, Implies):
+            continue
+        for premise in sorted(atoms(sub.lhs) - names):
+            for name in sorted(atoms(sub.rhs) & names):
+                _add(out, rebuild(_trade_literals(sub, premise, name)))
+    out.pop(to_text(formula), None)
+    return list(out.values())
+
+
+def _trade_literals(node: Implies, premise: str, name: str) -> Formula:
+    """``node`` with the literal of ``premise`` in its premise and that of ``name`` in its
+    consequence trading places, negation and all; other occurrences are renamed."""
+    first, second = _literal(node.lhs, premise), _literal(node.rhs, name)
+
+    def put(n: Formula) -> Formula:
+        if n == first:
+            return second
+        if n == second:
+            return first
+        if isinstance(n, Atom) and n.name in (premise, name):
+            return Atom(name if n.name == premise else premise)
+        return map_children(n, put)
+
+    return put(node)
+
+
+def _literal(node: Formula, name: str) -> Formula:
+    """How ``name`` first occurs in ``node``: negated (``!name``) or not."""
+    for sub in walk(node):
+        if isinstance(sub, Not) and sub.arg == Atom(name):
+            return sub
+        if sub == Atom(name):
+            return sub
+    raise ValueError(f"{name} does not occur in {to_text(node)}")
 
 
 def chained(formula: Formula) -> list[Formula]:

@@ -22,12 +22,13 @@ from typing import Any
 
 from ara.eval.translate.request import Request
 from ara.grammars import Formula, atoms, parse, walk
-from ara.grammars.ast import interval_of
+from ara.grammars.ast import Implies, interval_of, signed_atoms
 from ara.grammars.literal_edits import (
     chained,
     claim_edits,
     literal_edits,
     operator_drops,
+    swapped,
     unchained,
 )
 from ara.grammars.nesting import (
@@ -98,6 +99,22 @@ def unclaimed(request: Request, formula: Formula) -> tuple[str, ...]:
     return tuple(claim for claim in request.claims if claim not in said)
 
 
+def reversed_conditions(request: Request, formula: Formula) -> tuple[Formula, ...]:
+    """The implications of ``formula`` that read a condition its sentence names
+    (:attr:`Request.conditions`) as a consequence: where no premise names one, those
+    whose consequence states one unnegated and whose premise names what the sentence
+    says outside its conditions ("whenever the doorbell rings, go to the door":
+    ``G(at_door -> F(doorbell_rings))``). Negated there, it is the contrapositive
+    ``G(crusher_running -> !guard_off)`` of "never run the crusher while its guard is
+    off", and no gap; a premise the sentence names in words of its own ("no orders are
+    waiting" for ``queue_empty``) is not known to be misplaced."""
+    arrows = [node for node in walk(formula) if isinstance(node, Implies)]
+    if not request.conditions or any(atoms(a.lhs) & request.conditions for a in arrows):
+        return ()
+    return tuple(a for a in arrows if atoms(a.lhs) & request.outcomes
+                 and any((name, False) in signed_atoms(a.rhs) for name in request.conditions))
+
+
 def _written(formula: Formula) -> set[int]:
     ends = set()
     for node in walk(formula):
@@ -146,6 +163,11 @@ CHECKS = (
     Check("claims", unclaimed, lambda r, f, held: claim_edits(f, held),
           lambda held, r: [_asked_by(claim, r) for claim in held],
           ("never says {}", " or ")),
+    Check("condition", lambda r, f: tuple(dict.fromkeys(map(to_text, reversed_conditions(r, f)))),
+          lambda r, f, held: swapped(f, reversed_conditions(r, f), r.conditions),
+          lambda held, r: list(held),
+          ("writes {}, which puts what the sentence names as the condition after the "
+           "arrow", " and "), left_out=False),
 )
 #: The kinds of gap, in :data:`CHECKS`' order.
 KINDS = tuple(check.kind for check in CHECKS)
@@ -165,6 +187,8 @@ class Gaps:
             orders nothing in time.
         claims: What the sentence asks to hold over time, happen at some point or
             happen again and again, and the answer never claims (:func:`unclaimed`).
+        condition: Implications (canonical text) whose consequence holds what the
+            sentence names as the condition (:func:`reversed_conditions`).
     """
 
     aps: tuple[str, ...] = ()
@@ -172,6 +196,7 @@ class Gaps:
     unasked: tuple[str, ...] = ()
     order: bool = False
     claims: tuple[str, ...] = ()
+    condition: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return self.count()
@@ -188,7 +213,7 @@ class Gaps:
 
     def to_json(self) -> dict:
         """The gaps as ``ara translate --json`` writes them: ``left_out`` (``aps``,
-        ``numbers``, ``order``, ``claims``) and ``unasked``."""
+        ``numbers``, ``order``, ``claims``), ``unasked`` and ``condition``."""
         data: dict = {"left_out": {}}
         for check, held in self._held():
             place = data["left_out"] if check.left_out else data

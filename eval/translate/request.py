@@ -4,6 +4,7 @@ from its sentence (:mod:`ara.grammars.cues`), so that no candidate answer re-rea
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -15,6 +16,7 @@ from ara.grammars.cues import (
     NESTING_WORDS,
     NUMBER_WORDS,
     TIME_WORDS,
+    condition_clauses,
     says_in_order,
 )
 
@@ -43,6 +45,10 @@ class Request:
             (:data:`~ara.grammars.cues.NESTING_WORDS`).
         ordered: Whether it puts one step after another.
         any_order: Whether it lets its steps come in any order.
+        conditions: The propositions it names as a condition (:func:`conditions_named`):
+            "whenever the bin is full, empty it" names ``bin_full``.
+        outcomes: Those it names outside its conditions, where it has any (``empty_bin``
+            there); a proposition it names in neither way is in neither.
     """
 
     nl: str
@@ -56,6 +62,8 @@ class Request:
     allows: frozenset[str] = frozenset()
     ordered: bool = False
     any_order: bool = False
+    conditions: frozenset[str] = frozenset()
+    outcomes: frozenset[str] = frozenset()
 
     @classmethod
     def of(cls, nl: str, aps: Sequence[str]) -> Request:
@@ -83,7 +91,9 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
                    allows=frozenset(pair for pair, words in NESTING_WORDS.items()
                                     if words.search(text)),
                    ordered=says_in_order(text),
-                   any_order=ANY_ORDER_WORDS.search(text) is not None)
+                   any_order=ANY_ORDER_WORDS.search(text) is not None,
+                   **dict(zip(("conditions", "outcomes"), conditions_named(nl, aps),
+                              strict=True)))
 
 
 _STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
@@ -96,6 +106,44 @@ def mentions(nl: str, ap: str) -> bool:
         return True
     words = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
     return any(w in text for w in words)
+
+
+def conditions_named(nl: str, aps: Sequence[str]) -> tuple[frozenset[str], frozenset[str]]:
+    """The propositions of ``aps`` that ``nl`` names in a condition clause
+    (:func:`~ara.grammars.cues.condition_clauses`) more than elsewhere, and those it
+    names elsewhere more: ``prop_2`` and ``prop_1`` in "whenever ( prop_2 ) holds, (
+    prop_1 )"; ``bag_flagged`` and ``bag_at_inspection_room`` in "if security flags a bag,
+    take it to the inspection room". A name's words count where a word shares their stem."""
+    text = nl.lower()
+    spans = condition_clauses(text)
+    if not spans:
+        return frozenset(), frozenset()
+    inside = " ".join(text[a:b] for a, b in spans)
+    starts, ends = zip(*spans, strict=True)
+    outside = " ".join(text[a:b] for a, b in zip((0, *ends), (*starts, len(text)), strict=True))
+    inside_words, outside_words = _words(inside), _words(outside)
+    named: tuple[set[str], set[str]] = (set(), set())
+    for ap in aps:
+        if _LIFTED.fullmatch(ap):
+            here, there = (re.search(rf"\b{ap}\b", t) is not None for t in (inside, outside))
+        else:
+            parts = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
+            here, there = (sum(any(_same_stem(w, t) for t in words) for w in parts)
+                           for words in (inside_words, outside_words))
+        if here != there:
+            named[here < there].add(ap)
+    return frozenset(named[0]), frozenset(named[1])
+
+
+def _words(text: str) -> list[str]:
+    return re.findall(r"[a-z0-9]+", text)
+
+
+def _same_stem(name: str, word: str) -> bool:
+    """Whether a word of a proposition's name and a word of a sentence share their stem:
+    ``flagged`` and "flags", ``cleaning`` and "cleaned", not ``low`` and "lower"."""
+    common = len(os.path.commonprefix([name, word]))
+    return common >= min(len(name), 4) and common >= max(len(name), len(word)) - 3
 
 
 def digits_of(nl: str) -> frozenset[int]:

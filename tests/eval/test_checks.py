@@ -141,6 +141,43 @@ def test_generated_sentences_never_ask_for_a_claim_their_formula_lacks():
             record.nl, record.stl)
 
 
+def test_a_condition_read_as_the_consequence_is_a_gap():
+    """Tests that what a "whenever", "if" or "while" clause names belongs before the arrow,
+    that trading it with the premise mends the answer, and that a contrapositive passes."""
+    nl = "Sound the alarm within 10 seconds whenever a ward door is left open."
+    request = Request.of(nl, ["sound_alarm", "ward_door_open"])
+    slip = parse("G(sound_alarm -> F[0,10](ward_door_open))")
+    assert gaps(request, slip) == Gaps(condition=("sound_alarm -> F[0,10](ward_door_open)",))
+    assert "puts what the sentence names as the condition after the arrow" in (
+        gaps(request, slip).warning())
+    assert mends(request, slip) == [parse("G(ward_door_open -> F[0,10](sound_alarm))")]
+    assert not _gaps(nl, request.aps, "G(ward_door_open -> F[0,10](sound_alarm))")
+    # the negation goes with its proposition: not G(!guard_off -> running), which says the same
+    nl, aps = "Never run the crusher while its guard is off.", ["crusher_running", "guard_off"]
+    assert "G(guard_off -> !crusher_running)" in map(
+        to_text, mends(Request.of(nl, aps), parse("G(!crusher_running -> guard_off)")))
+    assert not _gaps(nl, aps, "G(crusher_running -> !guard_off)")  # the contrapositive
+    assert not _gaps(nl, aps, "G(!(crusher_running & guard_off))")  # no arrow to misread
+
+
+def test_sentences_that_leave_the_condition_open_name_none():
+    """Tests that "only when" and "unless" turn the condition round and NL2TL's "when
+    possible" is no condition, so the check reads nothing there."""
+    nl = "The forklift may only be in the cold room when the door is open."
+    assert not _gaps(nl, ["door_open", "in_cold_room"], "G(in_cold_room -> door_open)")
+    assert not _gaps("Keep the vacuum docked unless the house is empty.",
+                     ["vacuum_docked", "house_empty"], "G(!house_empty -> vacuum_docked)")
+    assert not _gaps("( prop_1 ) means that when possible ( prop_2 )", ["prop_1", "prop_2"],
+                     "prop_1 -> F(prop_2)")
+
+
+def test_generated_sentences_never_read_as_a_condition_turned_round():
+    """Tests that repair cannot undo the realizer's conditions."""
+    for record in synthetic_records(600, seed=7, held_out=False):
+        assert not gaps(Request.of(record.nl, record.aps), parse(record.stl)).condition, (
+            record.nl, record.stl)
+
+
 def test_mends_close_the_gap_of_their_kind():
     """Tests that each kind's mends write what was left out or drop what was added."""
     request = Request.of("Charge, then reach the dock within 9 steps.", ("charge", "at_dock"))
@@ -154,7 +191,7 @@ def test_mends_close_the_gap_of_their_kind():
 
 def test_each_kind_is_one_check_and_one_field_of_gaps():
     """Tests that the registry and the record of gaps name the same kinds, in order."""
-    assert KINDS == ("aps", "numbers", "unasked", "order", "claims")
+    assert KINDS == ("aps", "numbers", "unasked", "order", "claims", "condition")
     assert KINDS == tuple(check.kind for check in CHECKS) == tuple(f.name for f in fields(Gaps))
 
 
@@ -163,8 +200,9 @@ def test_kinds_of_a_gap_in_a_fixed_order_and_its_json_round_trip():
     gap = Gaps(aps=("a",), unasked=("G(F(b))",), order=True, claims=("G",))
     assert gap.kinds() == ["aps", "unasked", "order", "claims"]
     assert gap.to_json() == {"left_out": {"aps": ["a"], "numbers": [], "order": True,
-                                          "claims": ["G"]}, "unasked": ["G(F(b))"]}
-    assert list(gap.to_json()) == ["left_out", "unasked"]
+                                          "claims": ["G"]}, "unasked": ["G(F(b))"],
+                             "condition": []}
+    assert list(gap.to_json()) == ["left_out", "unasked", "condition"]
     assert Gaps.from_json(gap.to_json()) == gap
     assert not Gaps.from_json({"stl": None})  # an answer that did not parse has no fields
     assert gap.count(timed=False) == len(gap) == 4

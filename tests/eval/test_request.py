@@ -69,3 +69,21 @@ def test_the_nestings_a_sentence_allows():
     """Tests that "every so often" allows G(F) and "stay there" F(G), and neither the other."""
     assert Request.of("Inspect the forklift every so often.", ()).allows == {AGAIN_AND_AGAIN}
     assert Request.of("Go to the charging station and stay there.", ()).allows == {FOR_GOOD}
+
+
+def test_the_propositions_a_condition_clause_names():
+    """Tests that a proposition belongs to the condition where most of its words are."""
+    def named(nl, aps):
+        return Request.of(nl, aps).conditions
+
+    assert named("If security flags a bag, take it to the inspection room.",
+                 ["bag_flagged", "bag_at_inspection_room"]) == {"bag_flagged"}
+    assert named("Keep the lights on while you are deeper than 50 meters.",
+                 ["lights_on", "deeper_than_50m"]) == {"deeper_than_50m"}
+    assert named("whenever ( prop_2 ) is true, ( prop_1 ) must be false",
+                 ["prop_1", "prop_2"]) == {"prop_2"}
+    # "only when" turns it round; "at least once" and "once every" are no conditions
+    assert not named("Enter the cold room only when the door is open.",
+                     ["in_cold_room", "door_open"])
+    assert not named("Check the pump at least once, and once every hour after that.",
+                     ["check_pump"])

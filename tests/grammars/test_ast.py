@@ -2,8 +2,20 @@
 
 import pytest
 
-from ara.grammars import And, Atom, Eventually, Interval, Not, Or, Until, atoms, depth, max_bound
-from ara.grammars.ast import ASTError, atoms_read_now, rename_atoms
+from ara.grammars import (
+    And,
+    Atom,
+    Eventually,
+    Interval,
+    Not,
+    Or,
+    Until,
+    atoms,
+    depth,
+    max_bound,
+    parse,
+)
+from ara.grammars.ast import ASTError, atoms_read_now, rename_atoms, signed_atoms
 
 
 @pytest.mark.parametrize(
@@ -73,3 +85,9 @@ def test_the_language_core_needs_no_language_model():
         text = module.read_text()
         assert not any(name in text for name in ("llama_cpp", "import torch",
                                                  "transformers")), module.name
+
+
+def test_signed_atoms_read_an_implication_premise_as_a_negation():
+    assert signed_atoms(parse("G(a -> !F(b))")) == {("a", True), ("b", True)}
+    assert signed_atoms(parse("!(a -> b) & c")) == {("a", False), ("b", True), ("c", False)}
+    assert signed_atoms(parse("a <-> b")) == {(n, s) for n in "ab" for s in (True, False)}
