@@ -48,10 +48,15 @@ def _flat(d: dict, prefix: str = "") -> dict:
 
 
 def git_commit() -> str | None:
-    """The commit of the checkout this code runs from, or ``None`` outside git."""
+    """The commit of the checkout this code runs from, with ``+dirty`` where a tracked
+    file differs from it (the run's code is then in no commit), or ``None`` outside git."""
+    def git(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(["git", *args], capture_output=True, text=True,
+                              cwd=Path(__file__).parent, timeout=10)
+
     try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                             cwd=Path(__file__).parent, timeout=10)
+        commit = git("rev-parse", "HEAD").stdout.strip()
+        dirty = commit and git("diff", "--quiet", "HEAD").returncode == 1
     except (OSError, subprocess.TimeoutExpired):
         return None
-    return out.stdout.strip() or None
+    return (commit + "+dirty" if dirty else commit) or None
