@@ -26,11 +26,11 @@ the same rules; it judged repair's window check (``G[a,b](F)``) that day, while 
 waits for the recipe's second run; ``handwritten/suite9.yaml`` (split ``handwritten9``,
 149 entries: data centers and server rooms, film and TV sets, car washes and vehicle
 service bays, zoos and animal care, recycling and waste sorting plants) was written blind
-on 2026-11-27 by the same rules, to judge the change after the recipe's second run;
+on 2026-11-27 by the same rules; it judged repair's condition check that day;
 ``handwritten/suite10.yaml`` (split ``handwritten10``, 163 entries: elder care and
 nursing homes, electrical substations and power lines, theme parks and rides, laundries
 and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
-same rules, to judge the change after repair's condition check.
+same rules, to judge the change after that check.
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ _NAMED = sorted(filter(None, (re.fullmatch(r"suite([2-9]|[1-9]\d+)?", p.stem)
 SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
-WAITING = {"handwritten7": "the recipe's second run", "handwritten9": "the change after it",
+WAITING = {"handwritten7": "the recipe's second run",
            "handwritten10": "the change after the condition check"}
 
 
