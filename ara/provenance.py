@@ -49,7 +49,7 @@ def _flat(d: dict, prefix: str = "") -> dict:
 
 def git_commit() -> str | None:
     """The commit of the checkout this code runs from, with ``+dirty`` where a tracked
-    file differs from it (the run's code is then in no commit), or ``None`` outside git."""
+    file differs from it (an untracked new file does not count), or ``None`` outside git."""
     def git(*args: str) -> subprocess.CompletedProcess:
         return subprocess.run(["git", *args], capture_output=True, text=True,
                               cwd=Path(__file__).parent, timeout=10)

@@ -48,22 +48,30 @@ SEQUENCE_WORDS = re.compile(
     r"\b(and then|after that|afterwards?|followed by|one after the other|in (?:that|this) order"
     r"|subsequently|(?<!no )(?<!sooner or )later)\b")
 THEN = re.compile(r"[,;] then\b")
+#: Words that may open a condition, for :func:`says_in_order` (a ", then" after one
+#: closes the condition, it orders nothing); :data:`CONDITION_CLAUSE` is the narrower
+#: list whose clauses the condition check reads, where a wrong reading costs more.
 CONDITION_WORDS = re.compile(r"\b(if|when|whenever|in case|in the case|in the event|provided"
                              r"|as soon as|once|while|on condition|every ?time|each time)\b")
 #: Words that open a condition: what the clause after them names is read before the
 #: arrow ("whenever the bin is full, empty it": ``G(bin_full -> F(empty_bin))``).
-#: "When possible" is NL2TL's "at some point", "once every" a rate, "while" after a
-#: comma often a contrast.
+#: "Even if" and "as if" open none, nor "at once", "at least once" or "once every" (a
+#: rate); "when possible" is NL2TL's "at some point"; "while" after a comma is often a
+#: contrast ("a happens often, while b never does").
 CONDITION_CLAUSE = re.compile(
-    r"\b(?<!even )(?<!as )(whenever|if|when|each time|every ?time|once|as soon as"
+    r"\b(?<!even )(?<!as )(whenever|if|when|each time|every ?time"
+    r"|(?<!at )(?<!least )(?<!than )(?<!exactly )once|as soon as"
     r"|(?<![,;] )while|as long as|in case|in the event(?: that| of)?|provided(?: that)?)\b"
-    r"(?! possible| (?:every|more|in a while|again|and only)\b)")
+    r"(?! possible| (?:every|more|in a while|again)\b)")
 #: Sentences whose condition words do not say which side is the condition: "a only if
-#: b" and "unless" turn it round, "a means that b" puts it first, "if and only if"
-#: puts it on both sides, and "at once", "at least once" name no condition.
-NO_CONDITION_CLAUSE = re.compile(
-    r"\b(only|unless|except|means|infers?|implies|if and only if|iff|at once"
-    r"|(?:at least|more than|exactly) once)\b")
+#: b", "a only when b" and "unless" turn it round, "a means that b" puts it first, "if
+#: and only if" puts it on both sides.
+NO_CONDITION_CLAUSE = re.compile(r"\b(only|unless|except|means|infers?|implies|iff)\b")
+#: Words that negate what a clause says, or all of it before something ("when no
+#: cashier is at the register", "if you always avoid the gate", "if you wait until b
+#: before a": ``!a U b``).
+NEGATION_WORDS = re.compile(r"\b(no|not|never|none|nobody|nothing|neither|nor|without|false"
+                            r"|avoid\w*|away|out of|until|till|before)\b|n't\b")
 #: What ends a condition clause ("if the door opens, stop").
 _CLAUSE_END = re.compile(r"[,;.:!?]| then\b")
 

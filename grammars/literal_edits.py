@@ -149,13 +149,14 @@ def unchained(formula: Formula, nodes: Sequence[Formula]) -> list[Formula]:
     return list(out.values())
 
 
-def swapped(formula: Formula, nodes: Sequence[Formula], names: frozenset[str]) -> list[Formula]:
-    """Every formula with a literal of a premise and one of ``names`` in the consequence
-    of an implication of ``nodes`` trading places: ``G(at_door -> F(bell))`` becomes
-    ``G(bell -> F(at_door))`` (a condition read as the consequence), ``G(!running ->
-    guard_off)`` becomes ``G(guard_off -> !running)``. A negation stays with its
-    proposition: renaming alone would give ``G(!guard_off -> running)``, the
-    contrapositive of the answer, which says the same.
+def condition_trades(formula: Formula, nodes: Sequence[Formula],
+                     conditions: frozenset[str]) -> list[Formula]:
+    """Every formula with a premise's proposition and one of ``conditions`` in the
+    consequence of an implication of ``nodes`` trading places, each taking the other's
+    sign: ``G(at_door -> F(bell))`` becomes ``G(bell -> F(at_door))`` (a condition read as
+    the consequence), ``G(!running -> guard_off)`` becomes ``G(guard_off -> !running)``.
+    Renaming alone would give ``G(!guard_off -> running)``, the contrapositive of the
+    answer, which says the same.
 
     Returns:
         Distinct formulas (by canonical text), in a fixed order, ``formula`` excluded.
@@ -165,26 +166,26 @@ def swapped(formula: Formula, nodes: Sequence[Formula], names: frozenset[str]) -
     for sub, rebuild in _spots(formula):
         if sub not in targets or not isinstance(sub, Implies):
             continue
-        for premise in sorted(atoms(sub.lhs) - names):
-            for name in sorted(atoms(sub.rhs) & names):
-                _add(out, rebuild(_trade_literals(sub, premise, name)))
+        for premise in sorted(atoms(sub.lhs) - conditions):
+            for condition in sorted(atoms(sub.rhs) & conditions):
+                _add(out, rebuild(_trade(sub, premise, condition)))
     out.pop(to_text(formula), None)
     return list(out.values())
 
 
-def _trade_literals(node: Implies, premise: str, name: str) -> Formula:
-    """``node`` with the literal of ``premise`` in its premise and that of ``name`` in its
-    consequence trading places, negation and all; other occurrences are renamed."""
-    first, second = _literal(node.lhs, premise), _literal(node.rhs, name)
+def _trade(node: Implies, premise: str, condition: str) -> Formula:
+    """``node`` with ``premise`` and ``condition`` put for each other everywhere in it,
+    negated where their first literals differ in sign (so ``!premise`` in the premise
+    becomes ``condition``), double negations dropped."""
+    flip = isinstance(_literal(node.lhs, premise), Not) != isinstance(
+        _literal(node.rhs, condition), Not)
 
     def put(n: Formula) -> Formula:
-        if n == first:
-            return second
-        if n == second:
-            return first
-        if isinstance(n, Atom) and n.name in (premise, name):
-            return Atom(name if n.name == premise else premise)
-        return map_children(n, put)
+        if isinstance(n, Atom) and n.name in (premise, condition):
+            other = Atom(condition if n.name == premise else premise)
+            return Not(other) if flip else other
+        kid = map_children(n, put)
+        return kid.arg.arg if isinstance(kid, Not) and isinstance(kid.arg, Not) else kid
 
     return put(node)
 

@@ -48,6 +48,8 @@ for set in $sets; do
   case $set in
   handwritten*)
     [[ " $all_suites " == *" $set "* ]] || { echo "unknown suite $set ($all_suites)" >&2; exit 2; }
+    [[ " $suites " == *" $set "* ]] ||
+      echo "note: $set is a blind suite waiting for a change to judge (WAITING); its answers spend it" >&2
     run "$set" lifted 200; run "$set" grounded 200 ;;
   compositional) run compositional lifted "${LIMIT:-50}"; run compositional grounded "${LIMIT:-50}" ;;
   timed) run timed lifted "${LIMIT:-100}" ;;

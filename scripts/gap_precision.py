@@ -9,7 +9,10 @@ right and how many wrong.
 Sets: the first four hand-written suites and the sixth (not the fifth, nor those from the
 seventh on: blind judges, past or waiting), the compositional test side, NL2TL's timed dev
 file, the paper split's test side, and the compositional training mixture (whose NL2TL
-labels are noisy). Kinds: :data:`ara.eval.translate.checks.KINDS`.
+labels are noisy). Kinds: :data:`ara.eval.translate.checks.KINDS`. A reference's first
+implication written as its contrapositive (``!b -> !a`` for ``a -> b``) is the same
+formula, so a check that flags it would flag a right answer worded that way: the column
+"contrapositive" counts those.
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ from ara.data.handwritten import suite_records
 from ara.eval.metrics import gap_precision
 from ara.eval.translate.checks import KINDS, gaps
 from ara.eval.translate.request import Request
-from ara.grammars import parse
+from ara.grammars import Formula, Implies, Not, parse
+from ara.grammars.ast import children, with_children
 
 RESULTS = Path("docs/results/generalization")
 
@@ -42,6 +46,21 @@ def reference_sets() -> dict[str, list]:
             "NL2TL timed dev": load_or_prepare("timed").records("test"),
             "paper split, test side": load_or_prepare("paper").records("test"),
             "training mixture": compositional.records("train")}
+
+
+def contrapositive(formula: Formula) -> Formula | None:
+    """``formula`` with its first implication ``a -> b`` written ``!b -> !a``, or ``None``."""
+    if isinstance(formula, Implies):
+        return Implies(_negated(formula.rhs), _negated(formula.lhs))
+    kids = children(formula)
+    for i, kid in enumerate(kids):
+        if (new := contrapositive(kid)) is not None:
+            return with_children(formula, (*kids[:i], new, *kids[i + 1:]))
+    return None
+
+
+def _negated(formula: Formula) -> Formula:
+    return formula.arg if isinstance(formula, Not) else Not(formula)
 
 
 def run_answers(run: Path, variant: str) -> dict[str, list[dict]]:
@@ -70,8 +89,13 @@ def main(argv: list[str] | None = None) -> int:
     references = {}
     for name, records in reference_sets().items():
         counts = gap_precision(records)
+        rewritten = [(r, contrapositive(parse(r.stl))) for r in records]
         references[name] = {"references": len(records),
-                            **{k: counts[k]["references"] for k in KINDS}}
+                            **{k: counts[k]["references"] for k in KINDS},
+                            "contrapositive": sum(
+                                1 for r, c in rewritten if c is not None
+                                and gaps(Request.of(r.nl, r.aps), c)
+                                and not gaps(Request.of(r.nl, r.aps), parse(r.stl)))}
         flagged = ((r, gaps(Request.of(r.nl, r.aps), parse(r.stl)).kinds()) for r in records)
         for r, kinds in islice(((r, k) for r, k in flagged if k), args.show):
             print(f"  {name}: {'/'.join(kinds)}: {r.nl} -> {r.stl}", file=sys.stderr)
@@ -84,11 +108,11 @@ def main(argv: list[str] | None = None) -> int:
                                       for s, per in answers.items()}}, indent=1))
         return 0
     print("References a check flags (each is a right answer repair would act on):\n")
-    print("| set | references | " + " | ".join(KINDS) + " |")
-    print("|---|---:|" + "---:|" * len(KINDS))
+    print("| set | references | " + " | ".join(KINDS) + " | contrapositive |")
+    print("|---|---:|" + "---:|" * (len(KINDS) + 1))
     for name, row in references.items():
         print(f"| {name} | {row['references']:,} | "
-              + " | ".join(str(row[k]) for k in KINDS) + " |")
+              + " | ".join(str(row[k]) for k in (*KINDS, "contrapositive")) + " |")
     if answers:
         print(f"\nAnswers of `{args.run}` ({args.variant}) a check flags, right / wrong:\n")
         print("| set | " + " | ".join(KINDS) + " |")

@@ -17,7 +17,8 @@ def test_a_run_from_uncommitted_code_says_so(tmp_path, monkeypatch):
     git("init", "-q")
     (tmp_path / "code.py").write_text("x = 1\n")
     git("add", "code.py")
-    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "one")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false",
+        "commit", "-q", "-m", "one")
     monkeypatch.setattr(provenance, "__file__", str(tmp_path / "provenance.py"))
     clean = provenance.git_commit()
     assert clean is not None and len(clean) == 40

@@ -1,6 +1,6 @@
-"""What an answer leaves out of its request and what it adds unasked, one registry
-entry per kind of gap (:data:`CHECKS`): how it is found, which one-edit mends close it,
-what the warning and ``--json`` say.
+"""What an answer leaves out of its request, adds unasked or reads the wrong way round,
+one registry entry per kind of gap (:data:`CHECKS`): how it is found, which one-edit
+mends close it, what the warning and ``--json`` say.
 
 A translation that never uses a listed proposition, or a number the sentence states as
 a bound, is wrong whatever else it says: "reach the dock within 250 steps" has to put
@@ -22,13 +22,13 @@ from typing import Any
 
 from ara.eval.translate.request import Request
 from ara.grammars import Formula, atoms, parse, walk
-from ara.grammars.ast import Implies, interval_of, signed_atoms
+from ara.grammars.ast import Implies, atoms_read_now, interval_of, signed_atoms
 from ara.grammars.literal_edits import (
     chained,
     claim_edits,
+    condition_trades,
     literal_edits,
     operator_drops,
-    swapped,
     unchained,
 )
 from ara.grammars.nesting import (
@@ -102,17 +102,29 @@ def unclaimed(request: Request, formula: Formula) -> tuple[str, ...]:
 def reversed_conditions(request: Request, formula: Formula) -> tuple[Formula, ...]:
     """The implications of ``formula`` that read a condition its sentence names
     (:attr:`Request.conditions`) as a consequence: where no premise names one, those
-    whose consequence states one unnegated and whose premise names what the sentence
-    says outside its conditions ("whenever the doorbell rings, go to the door":
-    ``G(at_door -> F(doorbell_rings))``). Negated there, it is the contrapositive
-    ``G(crusher_running -> !guard_off)`` of "never run the crusher while its guard is
-    off", and no gap; a premise the sentence names in words of its own ("no orders are
-    waiting" for ``queue_empty``) is not known to be misplaced."""
+    whose premise names what the sentence says outside its conditions and whose
+    consequence states a condition as the premise should have (:func:`_read_as_result`):
+    ``G(at_door -> F(doorbell_rings))`` for "whenever the doorbell rings, go to the door"."""
     arrows = [node for node in walk(formula) if isinstance(node, Implies)]
     if not request.conditions or any(atoms(a.lhs) & request.conditions for a in arrows):
         return ()
     return tuple(a for a in arrows if atoms(a.lhs) & request.outcomes
-                 and any((name, False) in signed_atoms(a.rhs) for name in request.conditions))
+                 and any(_read_as_result(request, a.rhs, c) for c in request.conditions))
+
+
+def _read_as_result(request: Request, consequence: Formula, condition: str) -> bool:
+    """Whether ``consequence`` states ``condition``, which the sentence affirms, unnegated
+    (and not under ``<->``, which has no direction): as a reaction, under an ``F`` or
+    ``G``, or in the words the sentence says it in. ``G(drawer_open -> cashier_here)``
+    for "never leave the drawer open when no cashier is here" is the contrapositive of
+    the right answer, and so is ``G(crusher_running -> guard_on)`` for "never run the
+    crusher while its guard is off": a condition the clause negates, or a state it
+    names in other words, is no evidence."""
+    if condition not in request.affirmed_conditions or {
+            negated for name, negated in signed_atoms(consequence) if name == condition} != {False}:
+        return False
+    return (condition not in atoms_read_now(consequence)
+            or condition in request.plain_conditions)
 
 
 def _written(formula: Formula) -> set[int]:
@@ -164,7 +176,7 @@ CHECKS = (
           lambda held, r: [_asked_by(claim, r) for claim in held],
           ("never says {}", " or ")),
     Check("condition", lambda r, f: tuple(dict.fromkeys(map(to_text, reversed_conditions(r, f)))),
-          lambda r, f, held: swapped(f, reversed_conditions(r, f), r.conditions),
+          lambda r, f, held: condition_trades(f, reversed_conditions(r, f), r.conditions),
           lambda held, r: list(held),
           ("writes {}, which puts what the sentence names as the condition after the "
            "arrow", " and "), left_out=False),
@@ -188,7 +200,8 @@ class Gaps:
         claims: What the sentence asks to hold over time, happen at some point or
             happen again and again, and the answer never claims (:func:`unclaimed`).
         condition: Implications (canonical text) whose consequence holds what the
-            sentence names as the condition (:func:`reversed_conditions`).
+            sentence names as the condition, where no premise holds one
+            (:func:`reversed_conditions`).
     """
 
     aps: tuple[str, ...] = ()

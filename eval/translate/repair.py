@@ -50,8 +50,9 @@ REPAIR_BY = ("samples+edits", "edits", "samples")
 #: ``ara eval ablation``; each command adds its own default for ``samples``.
 REPAIR_HELP = {
     "samples": "K answers to draw when the first leaves part of the request out (a "
-               "proposition, a stated bound, an order, an 'always' or 'at some point') or "
-               "the model doubts it; one with fewer gaps wins.",
+               "proposition, a stated bound, an order, an 'always' or 'at some point'), "
+               "reads its 'whenever' clause as the consequence, or the model doubts it; "
+               "one with fewer gaps wins.",
     "by": "samples+edits: the K answers drawn and the formulas one edit from the greedy "
           "answer that close a gap; the one the model scores highest of those with the "
           "fewest gaps wins. edits: the edits alone. samples: the majority of the K drawn "

@@ -4,7 +4,6 @@ from its sentence (:mod:`ara.grammars.cues`), so that no candidate answer re-rea
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -13,6 +12,7 @@ from functools import lru_cache
 from ara.grammars.cues import (
     ANY_ORDER_WORDS,
     CLAIM_WORDS,
+    NEGATION_WORDS,
     NESTING_WORDS,
     NUMBER_WORDS,
     TIME_WORDS,
@@ -45,8 +45,12 @@ class Request:
             (:data:`~ara.grammars.cues.NESTING_WORDS`).
         ordered: Whether it puts one step after another.
         any_order: Whether it lets its steps come in any order.
-        conditions: The propositions it names as a condition (:func:`conditions_named`):
+        conditions: The propositions it names as a condition (:func:`read_conditions`):
             "whenever the bin is full, empty it" names ``bin_full``.
+        affirmed_conditions: Those of ``conditions`` a clause names and does not negate
+            (``bin_full`` there; not ``cashier_here`` in "when no cashier is here").
+        plain_conditions: Those of ``affirmed_conditions`` the clause names in all the
+            words of their names (not ``guard_on`` in "while its guard is off").
         outcomes: Those it names outside its conditions, where it has any (``empty_bin``
             there); a proposition it names in neither way is in neither.
     """
@@ -63,6 +67,8 @@ class Request:
     ordered: bool = False
     any_order: bool = False
     conditions: frozenset[str] = frozenset()
+    affirmed_conditions: frozenset[str] = frozenset()
+    plain_conditions: frozenset[str] = frozenset()
     outcomes: frozenset[str] = frozenset()
 
     @classmethod
@@ -83,6 +89,7 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
     text, unnamed = nl.lower(), _unnamed(nl, aps)
     found = [(claim, m.group(0)) for claim, words in CLAIM_WORDS.items()
              if (m := words.search(unnamed))]
+    conditions, affirmed, plain, outcomes = read_conditions(nl, aps)
     return Request(nl=nl, aps=aps, unmentioned=tuple(ap for ap in aps if not mentions(nl, ap)),
                    numbers=frozenset(written_numbers(nl)), digits=digits_of(nl),
                    stated=stated_numbers(nl, aps),
@@ -92,11 +99,19 @@ def _analysed(nl: str, aps: tuple[str, ...]) -> Request:
                                     if words.search(text)),
                    ordered=says_in_order(text),
                    any_order=ANY_ORDER_WORDS.search(text) is not None,
-                   **dict(zip(("conditions", "outcomes"), conditions_named(nl, aps),
-                              strict=True)))
+                   conditions=conditions, affirmed_conditions=affirmed,
+                   plain_conditions=plain, outcomes=outcomes)
 
 
 _STOPWORDS = frozenset({"the", "and", "for", "not", "with", "from", "into", "onto"})
+#: Short words of a name that say which state it is (``guard_on``, ``arm_up``): a
+#: clause in other words ("its guard is off") may name the opposite state.
+_STATE_WORDS = frozenset({"on", "off", "up", "down", "out"})
+
+
+def _name_words(ap: str) -> list[str]:
+    """The words of a proposition's name that can identify it: 3+ letters, not a stopword."""
+    return [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
 
 
 def mentions(nl: str, ap: str) -> bool:
@@ -104,46 +119,74 @@ def mentions(nl: str, ap: str) -> bool:
     text = nl.lower()
     if re.search(rf"\b{re.escape(ap.lower())}\b", text):
         return True
-    words = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
-    return any(w in text for w in words)
+    return any(w in text for w in _name_words(ap))
 
 
-def conditions_named(nl: str, aps: Sequence[str]) -> tuple[frozenset[str], frozenset[str]]:
-    """The propositions of ``aps`` that ``nl`` names in a condition clause
-    (:func:`~ara.grammars.cues.condition_clauses`) more than elsewhere, and those it
-    names elsewhere more: ``prop_2`` and ``prop_1`` in "whenever ( prop_2 ) holds, (
-    prop_1 )"; ``bag_flagged`` and ``bag_at_inspection_room`` in "if security flags a bag,
-    take it to the inspection room". A name's words count where a word shares their stem."""
+def read_conditions(nl: str, aps: Sequence[str]) -> tuple[frozenset[str], ...]:
+    """What ``nl`` names as conditions, affirmed, plainly, and as outcomes: the
+    :class:`Request` attributes ``conditions``, ``affirmed_conditions``,
+    ``plain_conditions`` and ``outcomes``.
+
+    A proposition belongs to the condition clauses
+    (:func:`~ara.grammars.cues.condition_clauses`) where more of its name's words stand
+    in them than elsewhere, to the outcomes where fewer: ``prop_2`` and ``prop_1`` in
+    "whenever ( prop_2 ) holds, ( prop_1 )"; ``bag_flagged`` and ``bag_at_inspection_room``
+    in "if security flags a bag, take it to the inspection room". Words match by stem."""
     text = nl.lower()
     spans = condition_clauses(text)
     if not spans:
-        return frozenset(), frozenset()
-    inside = " ".join(text[a:b] for a, b in spans)
+        return frozenset(), frozenset(), frozenset(), frozenset()
+    clauses = [text[a:b] for a, b in spans]
     starts, ends = zip(*spans, strict=True)
     outside = " ".join(text[a:b] for a, b in zip((0, *ends), (*starts, len(text)), strict=True))
-    inside_words, outside_words = _words(inside), _words(outside)
-    named: tuple[set[str], set[str]] = (set(), set())
+    inside_stems, outside_stems = _stems(" ".join(clauses)), _stems(outside)
+    conditions, affirmed, plain, outcomes = set(), set(), set(), set()
     for ap in aps:
         if _LIFTED.fullmatch(ap):
-            here, there = (re.search(rf"\b{ap}\b", t) is not None for t in (inside, outside))
+            here, there = (re.search(rf"\b{ap}\b", t) is not None
+                           for t in (" ".join(clauses), outside))
         else:
-            parts = [w for w in ap.lower().split("_") if len(w) >= 3 and w not in _STOPWORDS]
-            here, there = (sum(any(_same_stem(w, t) for t in words) for w in parts)
-                           for words in (inside_words, outside_words))
-        if here != there:
-            named[here < there].add(ap)
-    return frozenset(named[0]), frozenset(named[1])
+            stems = [_stem(w) for w in _name_words(ap)]
+            here, there = (sum(stem in words for stem in stems)
+                           for words in (inside_stems, outside_stems))
+        if here > there:
+            conditions.add(ap)
+            said = [c for c in clauses if _names(c, ap)]
+            if said and not any(NEGATION_WORDS.search(c) for c in said):
+                affirmed.add(ap)
+                plain.update([ap] if any(_names(c, ap, every_word=True) for c in said) else [])
+        elif here < there:
+            outcomes.add(ap)
+    return tuple(map(frozenset, (conditions, affirmed, plain, outcomes)))
 
 
-def _words(text: str) -> list[str]:
-    return re.findall(r"[a-z0-9]+", text)
+def _names(clause: str, ap: str, every_word: bool = False) -> bool:
+    """Whether ``clause`` says a word of ``ap``'s name, or with ``every_word`` all of
+    them, state words included (``on`` of ``guard_on``)."""
+    if _LIFTED.fullmatch(ap):
+        return re.search(rf"\b{ap}\b", clause) is not None
+    stems = {_stem(w) for w in _name_words(ap)}
+    if every_word:
+        stems |= {w for w in ap.lower().split("_") if w in _STATE_WORDS}
+        return stems <= _stems(clause)
+    return bool(stems & _stems(clause))
 
 
-def _same_stem(name: str, word: str) -> bool:
-    """Whether a word of a proposition's name and a word of a sentence share their stem:
-    ``flagged`` and "flags", ``cleaning`` and "cleaned", not ``low`` and "lower"."""
-    common = len(os.path.commonprefix([name, word]))
-    return common >= min(len(name), 4) and common >= max(len(name), len(word)) - 3
+def _stems(text: str) -> set[str]:
+    return {_stem(w) for w in re.findall(r"[a-z0-9]+", text)}
+
+
+def _stem(word: str) -> str:
+    """``word`` without an inflection: "flags" and "flagged" are "flag", "running" and
+    "run" "run", "cleaned" and "cleaning" "clean"; "lower" stays apart from "low"."""
+    for suffix in ("ing", "ed", "es", "s"):
+        if word.endswith(suffix) and len(word) - len(suffix) >= 3 \
+                and not word.endswith(("ss", "us")):
+            word = word[:-len(suffix)]
+            if len(word) > 3 and word[-1] == word[-2] and word[-1] not in "aeiouls":
+                word = word[:-1]  # "running", "flagged"
+            break
+    return word[:-1] if len(word) > 3 and word.endswith("e") else word  # "moving", "move"
 
 
 def digits_of(nl: str) -> frozenset[int]:

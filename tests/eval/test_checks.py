@@ -3,9 +3,18 @@
 from dataclasses import fields
 
 from ara.data.synthetic import synthetic_records
-from ara.eval.translate.checks import CHECKS, KINDS, Gaps, gaps, mends, unasked, unclaimed
+from ara.eval.translate.checks import (
+    CHECKS,
+    KINDS,
+    Gaps,
+    gaps,
+    mends,
+    reversed_conditions,
+    unasked,
+    unclaimed,
+)
 from ara.eval.translate.request import Request
-from ara.grammars import parse, to_text
+from ara.grammars import Implies, Not, parse, to_text, walk
 from ara.grammars.nesting import AGAIN_AND_AGAIN, FOR_GOOD, HAPPENS, HOLDS, RESTATED, nested_pairs
 
 
@@ -161,21 +170,41 @@ def test_a_condition_read_as_the_consequence_is_a_gap():
 
 
 def test_sentences_that_leave_the_condition_open_name_none():
-    """Tests that "only when" and "unless" turn the condition round and NL2TL's "when
-    possible" is no condition, so the check reads nothing there."""
+    """Tests that "only when" turns the condition round and NL2TL's "a means that b"
+    puts it first, so the check reads nothing there."""
     nl = "The forklift may only be in the cold room when the door is open."
     assert not _gaps(nl, ["door_open", "in_cold_room"], "G(in_cold_room -> door_open)")
-    assert not _gaps("Keep the vacuum docked unless the house is empty.",
-                     ["vacuum_docked", "house_empty"], "G(!house_empty -> vacuum_docked)")
-    assert not _gaps("( prop_1 ) means that when possible ( prop_2 )", ["prop_1", "prop_2"],
+    assert not _gaps("( prop_1 ) means that whenever ( prop_2 )", ["prop_1", "prop_2"],
                      "prop_1 -> F(prop_2)")
 
 
+def test_a_contrapositive_is_no_condition_turned_round():
+    """Tests that a state the clause names in other words, or negates, can sit after the
+    arrow: the answer may be the contrapositive of the one with it before."""
+    for nl, aps, right in [
+        ("Never run the crusher while its guard is off.", ["crusher_running", "guard_on"],
+         "G(crusher_running -> guard_on)"),
+        ("Do not enter the cold room when the door is closed.", ["in_cold_room", "door_open"],
+         "G(in_cold_room -> door_open)"),
+        ("Never leave the drawer open when no cashier is at the register.",
+         ["drawer_open", "cashier_at_register"], "G(drawer_open -> cashier_at_register)"),
+    ]:
+        assert not _gaps(nl, aps, right), nl
+    # a reaction has no contrapositive a sentence says, and <-> no direction
+    nl, aps = "Whenever the bell rings, go to the door.", ["bell_rings", "at_door", "lit"]
+    assert _gaps(nl, aps, "G(at_door -> F(bell_rings))").condition
+    assert not _gaps(nl, aps, "G(at_door -> (bell_rings <-> lit))")
+
+
 def test_generated_sentences_never_read_as_a_condition_turned_round():
-    """Tests that repair cannot undo the realizer's conditions."""
-    for record in synthetic_records(600, seed=7, held_out=False):
-        assert not gaps(Request.of(record.nl, record.aps), parse(record.stl)).condition, (
-            record.nl, record.stl)
+    """Tests that repair cannot undo the realizer's conditions, nor flag the
+    contrapositive of one (``!b -> !a`` for ``a -> b``), which says the same."""
+    for record in synthetic_records(1000, seed=7, held_out=False):
+        request, formula = Request.of(record.nl, record.aps), parse(record.stl)
+        assert not gaps(request, formula).condition, (record.nl, record.stl)
+        for arrow in (node for node in walk(formula) if isinstance(node, Implies)):
+            turned = Implies(Not(arrow.rhs), Not(arrow.lhs))
+            assert not reversed_conditions(request, turned), (record.nl, to_text(turned))
 
 
 def test_mends_close_the_gap_of_their_kind():

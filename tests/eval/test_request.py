@@ -76,14 +76,29 @@ def test_the_propositions_a_condition_clause_names():
     def named(nl, aps):
         return Request.of(nl, aps).conditions
 
-    assert named("If security flags a bag, take it to the inspection room.",
-                 ["bag_flagged", "bag_at_inspection_room"]) == {"bag_flagged"}
+    request = Request.of("If security flags a bag, take it to the inspection room.",
+                         ["bag_flagged", "bag_at_inspection_room"])
+    assert (request.conditions, request.outcomes) == ({"bag_flagged"}, {"bag_at_inspection_room"})
     assert named("Keep the lights on while you are deeper than 50 meters.",
                  ["lights_on", "deeper_than_50m"]) == {"deeper_than_50m"}
     assert named("whenever ( prop_2 ) is true, ( prop_1 ) must be false",
                  ["prop_1", "prop_2"]) == {"prop_2"}
-    # "only when" turns it round; "at least once" and "once every" are no conditions
+    # "only when" turns it round; "at least once" and "at once" open no condition
     assert not named("Enter the cold room only when the door is open.",
                      ["in_cold_room", "door_open"])
-    assert not named("Check the pump at least once, and once every hour after that.",
-                     ["check_pump"])
+    assert not named("Sound the alarm at least once and stop the pump at once.",
+                     ["sound_alarm", "stop_pump"])
+
+
+def test_a_condition_is_named_plainly_in_all_its_words_and_not_negated():
+    """Tests which conditions a clause says in the words of their names: only those can
+    tell a condition read as a consequence from a contrapositive."""
+    def plain(nl, aps):
+        request = Request.of(nl, aps)
+        return request.conditions, request.plain_conditions
+
+    assert plain("Stop whenever the guard is open.", ["stop", "guard_open"]) == (
+        {"guard_open"}, {"guard_open"})
+    assert plain("Stop whenever the guard is off.", ["stop", "guard_on"]) == ({"guard_on"}, set())
+    assert plain("Stop whenever no guard is present.", ["stop", "guard_present"]) == (
+        {"guard_present"}, set())

@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 
 from ara.grammars import atoms, parse, to_text, walk
 from ara.grammars.ast import Implies, interval_of
-from ara.grammars.literal_edits import claim_edits, literal_edits, swapped
+from ara.grammars.literal_edits import claim_edits, condition_trades, literal_edits
 from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, temporal_claims
 
 from conftest import formulas
@@ -90,14 +90,16 @@ def test_every_claim_edit_makes_the_claim_it_was_asked_for(formula, claim):
         assert to_text(edit) != original
 
 
-def test_a_condition_and_a_premise_trade_places_with_their_negations():
+def test_a_condition_and_a_premise_trade_places_with_their_signs():
     def trades(stl: str, names: set[str]) -> list[str]:
         formula = parse(stl)
         arrows = [node for node in walk(formula) if isinstance(node, Implies)]
-        return [to_text(f) for f in swapped(formula, arrows, frozenset(names))]
+        return [to_text(f) for f in condition_trades(formula, arrows, frozenset(names))]
 
     # "whenever the trough runs low, refill it within 10 minutes"
     assert trades("G(refill -> F[0,10](trough_low))", {"trough_low"}) == [
         "G(trough_low -> F[0,10](refill))"]
     assert trades("G(!running -> guard_off)", {"guard_off"}) == ["G(guard_off -> !running)"]
+    # every occurrence is put for the other, double negations dropped
+    assert trades("G(!p -> (c & F(!c)))", {"c"}) == ["G(c -> (!p & F(p)))"]
     assert trades("G(a -> b)", {"c"}) == []
