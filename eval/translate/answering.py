@@ -167,8 +167,8 @@ class Answer:
         ``ran_out``), ``error``, ``model``, ``constrained``, ``shots``, ``grammar``;
         ``samples`` (every answer, their groups and scores) where more than one was
         weighed; ``confidence``; ``alternatives`` (each ``stl`` and ``probability``);
-        ``left_out`` and ``unasked`` (:meth:`~ara.eval.translate.checks.Gaps.to_json`) where the
-        answer parses."""
+        ``left_out``, ``unasked`` and ``condition``
+        (:meth:`~ara.eval.translate.checks.Gaps.to_json`) where the answer parses."""
         r, vote = self.result, self.vote
         data = {"stl": r.stl, "valid": r.valid, "raw": r.raw, "ms": round(self.ms, 1),
                 "budget": {"s": self.budget_s, "ran_out": self.ran_out}, "error": r.error,

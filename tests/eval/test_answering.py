@@ -14,7 +14,7 @@ from ara.grammars import parse
 #: (Answer.to_json's docstring, docs/evaluation.md).
 DOCUMENTED_KEYS = ["stl", "valid", "raw", "ms", "budget", "error", "model", "constrained",
                    "shots", "grammar", "samples", "confidence", "alternatives", "left_out",
-                   "unasked"]
+                   "unasked", "condition"]
 
 
 def _result(stl: str, nl: str = "( prop_1 ) or ( prop_2 ) at some point") -> TranslationResult:
@@ -42,7 +42,7 @@ def test_the_json_of_an_answer_has_the_documented_keys_in_order():
     assert data["alternatives"] == [{"stl": "F(prop_1) | prop_2", "probability": 0.409}]
     greedy = Answer(_result(winner), "m").to_json()
     assert [k for k in DOCUMENTED_KEYS if k not in greedy] == ["samples", "left_out",
-                                                              "unasked"]
+                                                              "unasked", "condition"]
     assert greedy["ms"] == 12.3 and greedy["confidence"] is None
     assert greedy["budget"] == {"s": None, "ran_out": False}
     waited = Answer(vote.result, "m", vote, waited_ms=98.76, budget_s=5.0, ran_out=True)
