@@ -257,6 +257,10 @@ class LoRAFinetuneRecipe:
         oldest checkpoints beyond ``keep_checkpoints`` go (only once the new one is whole,
         so an interruption never leaves the run without one)."""
         folder = self.out / "checkpoints" / f"step_{self.step}"
+        if folder.joinpath("step.json").is_file():
+            # Already whole (the last step is also a checkpoint step): writing it again in
+            # place would leave a torn checkpoint that still reads as whole if killed.
+            return folder
         self.accelerator.save_state(str(folder))
         if self.accelerator.is_main_process:
             folder.joinpath("step.json").write_text(json.dumps({"step": self.step}))

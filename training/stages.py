@@ -295,10 +295,14 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
             log(f"stage {stage.name}: done, skipped"
                 + (" (trained without the held-out check)" if unchecked else ""))
             continue
-        resume = same and stage.kind == "train" and (folder / "run.json").is_file()
+        # A training stage killed before its first checkpoint has nothing to resume from.
+        checkpointed = any(folder.glob("checkpoints/step_*/step.json"))
+        resume = same and stage.kind == "train" and checkpointed
         if folder.exists() and not resume:
             # Made with other settings or from other inputs: it would mix two recipes.
-            log(f"stage {stage.name}: {_stale(recipe, stage, state, ran)}; rebuilding it")
+            why = ("it stopped before its first checkpoint" if same and stage.kind == "train"
+                   else _stale(recipe, stage, state, ran))
+            log(f"stage {stage.name}: {why}; rebuilding it")
             shutil.rmtree(folder)
             record["stages"].pop(stage.name, None)
         log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")

@@ -48,7 +48,10 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
     assert len(resumed.train()) == 2 and resumed.step == 8
     # The run's summary reads its log, so a session killed outright (which records no
     # time of its own) still counts: the first loss is step 1's, the seconds every step's.
-    resumed.save_checkpoint()
+    whole = resumed.save_checkpoint() / "step.json"
+    written = whole.stat().st_mtime_ns
+    resumed.save_checkpoint()  # a whole checkpoint is not written again in place
+    assert whole.stat().st_mtime_ns == written
     summary = run_training(TrainConfig.from_dict({**config.to_dict(), "max_steps": 9}),
                            resume=True)
     log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]

@@ -2,6 +2,7 @@
 to a soup, which a rerun continues and an edit rebuilds from the edited stage on."""
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -146,6 +147,15 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     lines.clear()
     run_recipe(recipe, log=lines.append)
     assert all(line.endswith("done, skipped") for line in lines) and len(lines) == 4
+
+    # A stage killed before its first checkpoint (its run.json written) starts again.
+    state = json.loads((out / "refine-b" / "stage.json").read_text())
+    (out / "refine-b" / "stage.json").write_text(json.dumps({**state, "done": False}))
+    shutil.rmtree(out / "refine-b" / "checkpoints")
+    lines.clear()
+    run_recipe(recipe, log=lines.append)
+    assert "stage refine-b: it stopped before its first checkpoint; rebuilding it" in lines
+    assert "stage soup: a stage it reads was rebuilt; rebuilding it" in lines
 
     # Asking for the held-out check later leaves the stages done, and says they lack it.
     checked = tiny_recipe(tiny_gemma_dir, out)
