@@ -181,7 +181,7 @@ class LoRAFinetuneRecipe:
         losses: list[float] = []
         bar = tqdm(total=self.total_steps, initial=self.step, desc="training", unit="step",
                    disable=not acc.is_main_process, dynamic_ncols=True)
-        log = open(self.out / "train_log.jsonl", "a") if acc.is_main_process else None
+        log = self._open_log() if acc.is_main_process else None
         self.model.train()
         # One optimizer step spans grad_accum micro-batches: its log line sums their
         # time and tokens and averages their losses.
@@ -245,6 +245,18 @@ class LoRAFinetuneRecipe:
             if log is not None:
                 log.close()
         return losses
+
+    def _open_log(self):
+        """``train_log.jsonl`` to append to, after ending the half line a killed session
+        may have left, so that no later step's line is glued to it."""
+        path = self.out / "train_log.jsonl"
+        if path.is_file() and path.stat().st_size:
+            with open(path, "rb") as f:
+                f.seek(-1, 2)
+                torn = f.read(1) != b"\n"
+            if torn:
+                path.open("a").write("\n")
+        return open(path, "a")
 
     def _shots(self, micro, epoch: int, index: int):
         """The batch's worked examples, drawn by its position (see ``shot_rng``)."""

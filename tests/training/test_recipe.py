@@ -45,16 +45,21 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
     resumed = LoRAFinetuneRecipe(longer, resume=True)
     resumed.setup()
     assert resumed.step == 6
+    with open(tmp_path / "run" / "train_log.jsonl", "a") as torn:  # a session killed mid-line
+        torn.write('{"step": 7, "lo')
     assert len(resumed.train()) == 2 and resumed.step == 8
-    # The run's summary reads its log, so a session killed outright (which records no
-    # time of its own) still counts: the first loss is step 1's, the seconds every step's.
+    lines = (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()
+    assert [json.loads(x)["step"] for x in lines[-2:]] == [7, 8]  # none glued to the half line
     whole = resumed.save_checkpoint() / "step.json"
     written = whole.stat().st_mtime_ns
     resumed.save_checkpoint()  # a whole checkpoint is not written again in place
     assert whole.stat().st_mtime_ns == written
+    # The run's summary reads its log, so a session killed outright (which records no
+    # time of its own) still counts: the first loss is step 1's, the seconds every step's.
     summary = run_training(TrainConfig.from_dict({**config.to_dict(), "max_steps": 9}),
                            resume=True)
-    log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()]
+    log = [json.loads(x) for x in (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()
+           if x.endswith("}")]  # not the half line
     assert summary["steps"] == 9 and len(log) == 9 and summary["first_loss"] == log[0]["loss"]
     assert summary["step_seconds"] == round(sum(x["seconds"] for x in log), 1) > 0
     with pytest.raises(Exception, match="already holds a run"):
