@@ -250,13 +250,10 @@ class LoRAFinetuneRecipe:
         """``train_log.jsonl`` to append to, after ending the half line a killed session
         may have left, so that no later step's line is glued to it."""
         path = self.out / "train_log.jsonl"
-        if path.is_file() and path.stat().st_size:
-            with open(path, "rb") as f:
-                f.seek(-1, 2)
-                torn = f.read(1) != b"\n"
-            if torn:
-                path.open("a").write("\n")
-        return open(path, "a")
+        log = open(path, "a")
+        if log.tell() and path.read_bytes()[-1:] != b"\n":
+            log.write("\n")
+        return log
 
     def _shots(self, micro, epoch: int, index: int):
         """The batch's worked examples, drawn by its position (see ``shot_rng``)."""
