@@ -25,7 +25,7 @@ from tqdm import tqdm
 from ara import __version__
 from ara.errors import ConfigError
 from ara.provenance import differing
-from ara.training.config import BOOKKEEPING, TrainConfig
+from ara.training.config import BOOKKEEPING, TrainConfig, whole_checkpoints
 from ara.training.dataset import (
     answer_loss_sum,
     batch_shots,
@@ -273,19 +273,13 @@ class LoRAFinetuneRecipe:
         self.accelerator.save_state(str(folder))
         if self.accelerator.is_main_process:
             folder.joinpath("step.json").write_text(json.dumps({"step": self.step}))
-            for old in self._checkpoints()[:-self.config.keep_checkpoints]:
+            for old in whole_checkpoints(self.out)[:-self.config.keep_checkpoints]:
                 shutil.rmtree(old)
         self.accelerator.wait_for_everyone()
         return folder
 
-    def _checkpoints(self) -> list[Path]:
-        """Whole checkpoints (``step.json`` is written last), oldest first."""
-        return sorted((p for p in (self.out / "checkpoints").glob("step_*")
-                       if p.joinpath("step.json").is_file()),
-                      key=lambda p: int(p.name.split("_")[1]))
-
     def _load_checkpoint(self) -> None:
-        found = self._checkpoints()
+        found = whole_checkpoints(self.out)
         if not found:
             raise ConfigError(f"--resume: no checkpoint in {self.out / 'checkpoints'}")
         self.accelerator.load_state(str(found[-1]))

@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ara.errors import ConfigError, did_you_mean
-from ara.training.config import BOOKKEEPING, TrainConfig
+from ara.training.config import BOOKKEEPING, TrainConfig, whole_checkpoints
 
 KINDS = ("train", "soup", "export")
 
@@ -215,8 +215,12 @@ def _peak_memory() -> dict:
     return peak
 
 
-def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str]) -> str:
-    """Why the folder of ``stage`` cannot be kept, in words for the log."""
+def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str],
+           same: bool) -> str:
+    """Why the folder of ``stage`` cannot be kept, in words for the log (``same``: its
+    settings and inputs are those it was made with)."""
+    if same and stage.kind == "train":
+        return "it stopped before its first checkpoint"
     if ran.intersection(stage.inputs):
         return "a stage it reads was rebuilt"
     run = recipe.folder(stage.name) / "run.json"
@@ -296,13 +300,11 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
                 + (" (trained without the held-out check)" if unchecked else ""))
             continue
         # A training stage killed before its first checkpoint has nothing to resume from.
-        checkpointed = any(folder.glob("checkpoints/step_*/step.json"))
-        resume = same and stage.kind == "train" and checkpointed
+        resume = same and stage.kind == "train" and bool(whole_checkpoints(folder))
         if folder.exists() and not resume:
-            # Made with other settings or from other inputs: it would mix two recipes.
-            why = ("it stopped before its first checkpoint" if same and stage.kind == "train"
-                   else _stale(recipe, stage, state, ran))
-            log(f"stage {stage.name}: {why}; rebuilding it")
+            # Made with other settings or from other inputs (it would mix two recipes), or
+            # cut short before anything in it could be resumed.
+            log(f"stage {stage.name}: {_stale(recipe, stage, state, ran, same)}; rebuilding it")
             shutil.rmtree(folder)
             record["stages"].pop(stage.name, None)
         log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")

@@ -138,13 +138,13 @@ def read_conditions(nl: str, aps: Sequence[str]) -> tuple[frozenset[str], ...]:
         return frozenset(), frozenset(), frozenset(), frozenset()
     clauses = [text[a:b] for a, b in spans]
     starts, ends = zip(*spans, strict=True)
+    inside = " ".join(clauses)
     outside = " ".join(text[a:b] for a, b in zip((0, *ends), (*starts, len(text)), strict=True))
-    inside_stems, outside_stems = _stems(" ".join(clauses)), _stems(outside)
+    inside_stems, outside_stems = _stems(inside), _stems(outside)
     conditions, affirmed, plain, outcomes = set(), set(), set(), set()
     for ap in aps:
         if _LIFTED.fullmatch(ap):
-            here, there = (re.search(rf"\b{ap}\b", t) is not None
-                           for t in (" ".join(clauses), outside))
+            here, there = (re.search(rf"\b{ap}\b", t) is not None for t in (inside, outside))
         else:
             stems = [_stem(w) for w in _name_words(ap)]
             here, there = (sum(stem in words for stem in stems)
