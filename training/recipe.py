@@ -16,6 +16,7 @@ import json
 import random
 import shutil
 import time
+from functools import lru_cache
 from pathlib import Path
 
 import torch
@@ -71,9 +72,7 @@ class LoRAFinetuneRecipe:
         self.model_dir = self._base_model_dir()
         # The tokenizer before the data (examples are token ids), the data before the
         # schedule (its length sets the number of steps).
-        from transformers import AutoTokenizer
-
-        self.tokenizer = AutoTokenizer.from_pretrained(self.model_dir, local_files_only=True)
+        self.tokenizer = _tokenizer(str(self.model_dir), _stamp(self.model_dir))
         # The first use of a registered split prepares it; one process writes it.
         with self.accelerator.main_process_first():
             self.train_records, self.split = self._load_data()
@@ -328,6 +327,22 @@ class LoRAFinetuneRecipe:
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
 #: and those that leave the adapter as it is.
 _RESUMABLE_KEYS = BOOKKEEPING | {"max_steps"}
+
+
+@lru_cache(maxsize=2)
+def _tokenizer(model_dir: str, stamp: tuple):
+    """The base model's tokenizer, read once per process: parsing Gemma's 262k vocabulary
+    takes seconds, and a recipe's stages (and a test's many short runs) read the same one.
+    ``stamp`` keys the cache to the files, so a rewritten folder is read again. Training
+    only reads it (encodes, pads, saves a copy beside each adapter)."""
+    from transformers import AutoTokenizer
+
+    return AutoTokenizer.from_pretrained(model_dir, local_files_only=True)
+
+
+def _stamp(model_dir) -> tuple:
+    return tuple(sorted((f.name, f.stat().st_mtime_ns, f.stat().st_size)
+                        for f in Path(model_dir).glob("*token*")))
 
 
 def _warm_started(base, folder: str, lora):

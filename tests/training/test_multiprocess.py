@@ -11,13 +11,6 @@ import yaml
 pytest.importorskip("accelerate", reason="needs the train extra (make setup)")
 
 
-@pytest.fixture(scope="module")
-def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
-    from ara.training.tiny import build_tiny_gemma
-
-    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
-
-
 def _free_port() -> int:
     import socket
 

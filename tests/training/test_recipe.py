@@ -9,14 +9,6 @@ from ara.training.config import TrainConfig
 from ara.training.recipe import LoRAFinetuneRecipe, run_training
 
 
-@pytest.fixture(scope="module")
-def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
-    """A 2-layer, 32-wide Gemma 3 with random weights and the real 262k tokenizer."""
-    from ara.training.tiny import build_tiny_gemma
-
-    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
-
-
 def tiny_config(model_dir, out, **overrides):
     base = {"base_model": model_dir, "out": str(out), "seed": 0, "checkpoint_every": 3,
             "eval_pairs": 0, "max_steps": 6,

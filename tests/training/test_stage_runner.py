@@ -15,14 +15,6 @@ from ara.training.stages import StagedRecipe, run_recipe
 SHIPPED_RECIPE = Path(__file__).parents[2] / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
 
 
-@pytest.fixture(scope="module")
-def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
-    """A 2-layer, 32-wide Gemma 3 with random weights and the real 262k tokenizer."""
-    from ara.training.tiny import build_tiny_gemma
-
-    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
-
-
 def tiny_recipe(model_dir, out, refine_b_seed=2) -> dict:
     """The shipped recipe's shape (a start, two refinements from it, their soup at the
     start's rank) on a tiny model and a few steps."""
