@@ -39,6 +39,9 @@ from ara.errors import ConfigError, did_you_mean
 from ara.training.config import BOOKKEEPING, TrainConfig, whole_checkpoints
 
 KINDS = ("train", "soup", "export")
+# Where a rebuilt training stage's old folder goes: hours of training are not deleted by
+# an edit, nor by a release whose settings read differently.
+REPLACED = "replaced"
 
 
 @dataclass(frozen=True)
@@ -63,6 +66,9 @@ class Stage:
     def __post_init__(self) -> None:
         if not self.name or not all(c.isalnum() or c in "-_" for c in self.name):
             raise ConfigError(f"stage name {self.name!r}: use letters, digits, '-' and '_'")
+        if self.name == REPLACED:
+            raise ConfigError(f"stage name {REPLACED!r} is the recipe's folder for rebuilt "
+                              "stages' old folders; choose another")
         if self.kind not in KINDS:
             raise ConfigError(f"stage {self.name}: kind {self.kind!r} is not one of {KINDS}")
         if self.kind == "soup" and len(self.inputs) < 2 and self.settings.get("rank") is None:
@@ -238,6 +244,22 @@ def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str]
         "it stopped before its run began")
 
 
+def _has_training(folder: Path) -> bool:
+    return (folder / "adapter").is_dir() or bool(whole_checkpoints(folder))
+
+
+def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
+    """Move a stage's folder under ``out/replaced/``, named by when it was replaced."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    dest, n = recipe.out / REPLACED / f"{folder.name}-{stamp}", 1
+    while dest.exists():
+        n += 1
+        dest = dest.with_name(f"{folder.name}-{stamp}-{n}")
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    shutil.move(str(folder), str(dest))
+    return dest
+
+
 def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
                max_steps: int | None) -> dict:
     folder = recipe.folder(stage.name)
@@ -304,8 +326,14 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
         if folder.exists() and not resume:
             # Made with other settings or from other inputs (it would mix two recipes), or
             # cut short before anything in it could be resumed.
-            log(f"stage {stage.name}: {_stale(recipe, stage, state, ran, same)}; rebuilding it")
-            shutil.rmtree(folder)
+            why = _stale(recipe, stage, state, ran, same)
+            kept = (_set_aside(recipe, folder)
+                    if stage.kind == "train" and _has_training(folder) else None)
+            if kept is None:
+                shutil.rmtree(folder)
+            log(f"stage {stage.name}: {why}; rebuilding it"
+                + (f" (the old folder is kept as {kept}; delete it once unneeded)" if kept
+                   else ""))
             record["stages"].pop(stage.name, None)
         log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")
         before = {"wall_s": state.get("wall_s", 0.0), "sessions": state.get("sessions", 0)} \

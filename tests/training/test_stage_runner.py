@@ -89,6 +89,7 @@ def test_a_stage_trained_on_the_registered_data_is_stale_once_another_version_is
      "reads 'b', which is not a stage before it"),
     ([{"name": "a", "train": {"out": "elsewhere"}}], "out is set by the recipe"),
     ([{"name": "a", "train": {}}, {"name": "a", "train": {}}], "two stages are named a"),
+    ([{"name": "replaced", "train": {}}], "folder for rebuilt stages' old folders"),
     ([{"name": "a", "train": {}}, {"name": "s", "soup": ["a"]}], "a soup needs two stages"),
     ([{"name": "a", "train": {}}, {"name": "e", "export": "a"}, {"name": "f", "export": "e"}],
      "reads e, an export"),
@@ -143,7 +144,8 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     # A stage killed before its first checkpoint (its run.json written) starts again.
     state = json.loads((out / "refine-b" / "stage.json").read_text())
     (out / "refine-b" / "stage.json").write_text(json.dumps({**state, "done": False}))
-    shutil.rmtree(out / "refine-b" / "checkpoints")
+    for part in ("checkpoints", "adapter"):
+        shutil.rmtree(out / "refine-b" / part)
     lines.clear()
     run_recipe(recipe, log=lines.append)
     assert "stage refine-b: it stopped before its first checkpoint; rebuilding it" in lines
@@ -159,7 +161,8 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         "stage soup: done, skipped"]
 
     # An edited stage is rebuilt with the stages that read it, and the log says why (here
-    # refine-b was also trained on data an earlier release registered).
+    # refine-b was also trained on data an earlier release registered); its old folder is
+    # kept, since an edit (or a release reading settings anew) must not delete hours.
     soup_before = (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes()
     run_json = out / "refine-b" / "run.json"
     run = json.loads(run_json.read_text())
@@ -169,10 +172,15 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     run_recipe(edited, log=lines.append)
     assert [line for line in lines if "skipped" in line] == [
         "stage start: done, skipped", "stage refine-a: done, skipped"]
+    (kept,) = (out / "replaced").iterdir()
     assert [line for line in lines if "rebuilding" in line] == [
         "stage refine-b: it was trained on paper version 000000000000 and this run asks "
         f"for {registered_version('paper', 0)} (to keep it, pin data.version: "
-        "000000000000 in the config, where that version is still prepared); rebuilding it",
+        "000000000000 in the config, where that version is still prepared); rebuilding it "
+        f"(the old folder is kept as {kept}; delete it once unneeded)",
         "stage soup: a stage it reads was rebuilt; rebuilding it"]
+    assert kept.name.startswith("refine-b-") and json.loads(
+        (kept / "run.json").read_text())["data"]["version"] == "000000000000"
+    assert (kept / "adapter" / "adapter_model.safetensors").is_file()
     assert "stage refine-b: started (train)" in lines and "stage soup: started (soup)" in lines
     assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
