@@ -151,6 +151,15 @@ def hf_model_dir():
 
 
 @pytest.fixture(scope="session")
+def tiny_gemma_dir(tmp_path_factory, hf_model_dir):
+    """A 2-layer, 32-wide Gemma 3 with random weights and the real 262k tokenizer, built
+    once for the training tests."""
+    from ara.training.tiny import build_tiny_gemma
+
+    return build_tiny_gemma(tmp_path_factory.mktemp("tiny-gemma"), hf_model_dir)
+
+
+@pytest.fixture(scope="session")
 def hf_backend(hf_model_dir):
     """The embedded model through transformers with llguidance masks (loaded once)."""
     from ara.eval.translate.backends.hf_backend import HFBackend

@@ -88,6 +88,16 @@ def test_grammar_with_bad_propositions_exits_2():
     assert out.returncode == 2 and "'F' is not a valid name" in out.stderr
 
 
+@pytest.mark.usefixtures("embedded_model_path")
+def test_model_prepare_leaves_a_folder_it_did_not_write_alone(tmp_path):
+    """Tests that `ara model prepare --out DIR` refuses a folder of the user's own: the
+    conversion replaces its target whole."""
+    (tmp_path / "notes.txt").write_text("mine")
+    out = ara("model", "prepare", "--out", str(tmp_path))
+    assert out.returncode == 2 and "is not empty and holds no ara_model.json" in out.stderr
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
 def test_data_prepare_and_stats(tmp_path):
     """Tests `ara data prepare` then `ara data stats --json` on a fresh root, and stats
     of a split the root lacks, through the installed entry point: the note on stderr is

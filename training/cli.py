@@ -14,7 +14,9 @@ model_app = typer.Typer(help="Prepare base models (no downloads).", no_args_is_h
 @model_app.command("prepare")
 def prepare_cmd(
     out: Path = typer.Option(None, "--out",
-                             help="Target folder [default: ~/.cache/ara/models/gemma-3-270m-hf]."),
+                             help="The folder to write, new or an earlier conversion (it "
+                                  "is replaced whole) "
+                                  "[default: ~/.cache/ara/models/gemma-3-270m-hf]."),
     gguf: str = typer.Option(None, "--gguf", help="GGUF to convert [default: embedded 270M]."),
     force: bool = typer.Option(False, "--force", help="Convert again even if done."),
 ) -> None:
@@ -32,7 +34,8 @@ def train_cmd(
                                      "`stages:`), e.g. training/configs/gemma3_270m_nl2tl.yaml."),
     max_steps: int = typer.Option(
         None, "--max-steps",
-        help="Stop after N optimizer steps (in a recipe: each training stage, a smoke run)."),
+        help="Stop after N optimizer steps (in a recipe: each training stage at most N, a "
+             "smoke run whose stages a run without the flag trains again)."),
     resume: bool = typer.Option(
         False, "--resume",
         help="Continue a single run from its newest checkpoint (a recipe always goes on "

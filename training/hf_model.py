@@ -63,6 +63,10 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     digest = sha256_file(gguf)
     if not force and is_prepared(out, digest):
         return out
+    # The folder is replaced whole: only one this function wrote (or none) may be.
+    if out.exists() and not (out / MANIFEST).is_file() and any(Path(out).iterdir()):
+        raise ModelPrepError(f"{out} is not empty and holds no {MANIFEST}: name a new "
+                             "folder for the conversion (it is replaced whole)")
 
     import transformers
     from transformers import AutoModelForCausalLM, AutoTokenizer

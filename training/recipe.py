@@ -16,6 +16,7 @@ import json
 import random
 import shutil
 import time
+import warnings
 from functools import lru_cache
 from pathlib import Path
 
@@ -67,7 +68,12 @@ class LoRAFinetuneRecipe:
         from accelerate.utils import set_seed
 
         # The accelerator first: it decides the device and process group everything uses.
-        self.accelerator = Accelerator(gradient_accumulation_steps=self.config.optim.grad_accum)
+        # The scheduler steps once an optimizer step, by hand: accelerate's own stepping
+        # assumes each process has a batch of its own and steps it once per process,
+        # where here the processes split one global batch (the schedule ran N times
+        # too fast on N GPUs).
+        self.accelerator = Accelerator(gradient_accumulation_steps=self.config.optim.grad_accum,
+                                       step_scheduler_with_optimizer=False)
         set_seed(self.config.seed)
         self.model_dir = self._base_model_dir()
         # The tokenizer before the data (examples are token ids), the data before the
@@ -80,6 +86,13 @@ class LoRAFinetuneRecipe:
         total = per_epoch * self.config.optim.epochs // self.config.optim.grad_accum
         self.total_steps = min(total, self.config.max_steps or total)
         self.steps_per_epoch = per_epoch // self.config.optim.grad_accum
+        if not self.steps_per_epoch or not self.total_steps:
+            optim = self.config.optim
+            raise ConfigError(
+                f"{len(self.train_records)} training records make {per_epoch} batches of "
+                f"{optim.batch_size}, fewer than one optimizer step of grad_accum "
+                f"{optim.grad_accum}: train on more records (data.forms, data.limit) or "
+                "lower batch_size or grad_accum")
         model = self._lora_model()
         optimizer = torch.optim.AdamW([p for p in model.parameters() if p.requires_grad],
                                       lr=self.config.optim.lr,
@@ -212,7 +225,8 @@ class LoRAFinetuneRecipe:
                         # DDP averages gradients over processes: scale back to the sum
                         acc.backward(total * weight * world / counted)
                         self.optimizer.step()
-                        self.scheduler.step()
+                        if acc.sync_gradients:
+                            self.scheduler.step()
                         self.optimizer.zero_grad()
                     micro_losses.append(float(loss_sum / counted))
                     micro_shots.append(len(shots))
@@ -280,7 +294,13 @@ class LoRAFinetuneRecipe:
     def _load_checkpoint(self) -> None:
         found = whole_checkpoints(self.out)
         if not found:
-            raise ConfigError(f"--resume: no checkpoint in {self.out / 'checkpoints'}")
+            # Killed before its first checkpoint: nothing to go on from, so it starts over
+            # (its log's steps are taken again).
+            warnings.warn(f"{self.out} has no checkpoint yet: training starts again from "
+                          "step 0", stacklevel=2)
+            if self.accelerator.is_main_process:
+                self.out.joinpath("train_log.jsonl").unlink(missing_ok=True)
+            return
         self.accelerator.load_state(str(found[-1]))
         self.step = json.loads(found[-1].joinpath("step.json").read_text())["step"]
 
@@ -390,16 +410,21 @@ def _adapter_identity(folder: str | Path | None) -> dict | None:
 
 
 def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
-    """A resumed run continues the same training: the same data, schedule and model."""
-    changed = {k: values for k, values in differing(
-        json.loads(run_json.read_text())["config"], config.to_dict()).items()
-        if k not in _RESUMABLE_KEYS}
+    """A resumed run continues the same training: the same data, schedule and model.
+    The data version is compared as loaded (``_load_data``), not as written: pinning
+    the version a run started on unpinned is no change."""
+    started, now = json.loads(run_json.read_text())["config"], config.to_dict()
+    started["data"] = {**started["data"], "version": None}
+    now["data"] = {**now["data"], "version": None}
+    changed = {k: values for k, values in differing(started, now).items()
+               if k not in _RESUMABLE_KEYS}
     if changed:
         detail = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
+        may = ", ".join(sorted(_RESUMABLE_KEYS))
         raise ConfigError(
             f"--resume: the config differs from the one {run_json.parent} was started with "
-            f"({detail}); resume with the same config (only max_steps, checkpoint_every, "
-            "keep_checkpoints and eval_pairs may change), or train into another out folder")
+            f"({detail}); resume with the same config (only {may} may change), or train "
+            "into another out folder")
 
 
 def _log_summary(path: Path) -> dict:

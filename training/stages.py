@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import resource
 import shutil
 import sys
@@ -225,8 +226,9 @@ def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str]
            same: bool) -> str:
     """Why the folder of ``stage`` cannot be kept, in words for the log (``same``: its
     settings and inputs are those it was made with)."""
-    if same and stage.kind == "train":
-        return "it stopped before its first checkpoint"
+    if same:
+        return ("it stopped before its first checkpoint" if stage.kind == "train"
+                else "it stopped before it was done")
     if ran.intersection(stage.inputs):
         return "a stage it reads was rebuilt"
     run = recipe.folder(stage.name) / "run.json"
@@ -268,7 +270,8 @@ def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
 
         config = recipe.train_config(stage)
         if max_steps is not None:
-            config = TrainConfig.from_dict({**config.to_dict(), "max_steps": max_steps})
+            capped = min(config.max_steps or max_steps, max_steps)
+            config = TrainConfig.from_dict({**config.to_dict(), "max_steps": capped})
         return run_training(config, resume)
     if stage.kind == "soup":
         from ara.training.soup import soup_runs
@@ -302,6 +305,11 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
             part of each stage's fingerprint, so a later full run starts them again.
         log: Where a line per stage goes.
     """
+    if int(os.environ.get("WORLD_SIZE", "1")) > 1:
+        # Every process would set stages aside, write their records, soup and export.
+        raise ConfigError("a staged recipe runs in one process (its stage records, soups and "
+                          "exports are written once): run it on one GPU "
+                          "(scripts/train_gpu.sh does), or give several a single-run config")
     prints = recipe.fingerprints()
     if max_steps is not None:
         prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}

@@ -4,6 +4,7 @@ import json
 
 import pytest
 
+from ara.data import registered_version
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
 from ara.training.recipe import LoRAFinetuneRecipe, run_training
@@ -56,11 +57,40 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
     assert summary["step_seconds"] == round(sum(x["seconds"] for x in log), 1) > 0
     with pytest.raises(Exception, match="already holds a run"):
         LoRAFinetuneRecipe(config)
+    # Pinning the version the run started on (unpinned) is no change.
+    pinned = {**config.to_dict()["data"], "version": registered_version("paper", 0)}
+    LoRAFinetuneRecipe(TrainConfig.from_dict({**config.to_dict(), "data": pinned}),
+                       resume=True)
     # Resuming with another learning rate would silently train something else.
     changed = TrainConfig.from_dict({**config.to_dict(), "optim": {**config.to_dict()["optim"],
                                                                    "lr": 1e-3}})
     with pytest.raises(ConfigError, match=r"optim.lr: 0.005 -> 0.001"):
         LoRAFinetuneRecipe(changed, resume=True)
+
+
+def test_a_run_killed_before_its_first_checkpoint_resumes_from_step_0(tiny_gemma_dir,
+                                                                     tmp_path):
+    """Tests `--resume` on a run that wrote its record and a few log lines, then died
+    before its first checkpoint: it starts over, and its log holds each step once."""
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=2, checkpoint_every=5)
+    recipe = LoRAFinetuneRecipe(config)
+    recipe.setup()
+    recipe.train()  # stops at step 2, as a run killed before its first checkpoint
+    assert not (tmp_path / "run" / "checkpoints").exists()
+    resumed = LoRAFinetuneRecipe(config, resume=True)
+    with pytest.warns(UserWarning, match="no checkpoint yet: training starts again"):
+        resumed.setup()
+    assert resumed.step == 0 and len(resumed.train()) == 2
+    log = (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()
+    assert [json.loads(x)["step"] for x in log] == [1, 2]
+
+
+def test_too_few_records_for_one_optimizer_step_are_refused(tiny_gemma_dir, tmp_path):
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run",
+                         optim={"lr": 5e-3, "batch_size": 8, "grad_accum": 2})
+    with pytest.raises(ConfigError, match="8 training records make 1 batches of 8, fewer "
+                                          "than one optimizer step of grad_accum 2"):
+        LoRAFinetuneRecipe(config).setup()
 
 
 @pytest.mark.slow  # the harness runs a real model by default (test_resume_after_kill)

@@ -102,6 +102,17 @@ def test_a_recipe_that_cannot_run_is_refused_before_anything_trains(stages, mess
         StagedRecipe.from_dict({"out": "runs/x", "stages": stages})
 
 
+def test_a_recipe_is_refused_in_several_processes(tmp_path, monkeypatch):
+    """Tests the guard against `accelerate launch` of a staged recipe: every process
+    would set stages aside, soup and export."""
+    monkeypatch.setenv("WORLD_SIZE", "2")
+    recipe = StagedRecipe.from_dict({"out": str(tmp_path), "stages": [
+        {"name": "a", "train": {}}]})
+    with pytest.raises(ConfigError, match="a staged recipe runs in one process"):
+        run_recipe(recipe)
+    assert not list(tmp_path.iterdir())
+
+
 def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         tiny_gemma_dir, paper_split, tmp_path):
     """Tests the runner end to end on a tiny Gemma 3: interrupted between stages, a rerun
