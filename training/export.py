@@ -164,6 +164,7 @@ def export_checked(run_dir: Path, quants: tuple[str, ...] | list[str] = ("f16",)
     the first ``parity_pairs`` test pairs of the data version the run trained on (0: no
     check); the manifest, with ``parity``, is ``run_dir/export/export.json``."""
     quants = tuple(quants)
+    _check_before_work(Path(run_dir), quants, parity_pairs)
     outtype = "f32" if "f32" in quants else "f16"
     manifest = export_run(Path(run_dir), quants, lora_gguf, outtype)
     if parity_pairs:
@@ -179,3 +180,17 @@ def export_checked(run_dir: Path, quants: tuple[str, ...] | list[str] = ("f16",)
                                     records)
         (export / "export.json").write_text(json.dumps(manifest, indent=2) + "\n")
     return manifest
+
+
+def _check_before_work(run_dir: Path, quants: tuple[str, ...], parity_pairs: int) -> None:
+    """What would fail after minutes of merging and converting, refused at once."""
+    unknown = [q for q in quants if q not in QUANT_TYPES]
+    if unknown or not quants:
+        raise ExportError(f"unknown quantization {unknown or quants!r}; choose from "
+                          f"{sorted(QUANT_TYPES)}")
+    if parity_pairs < 0:
+        raise ExportError(f"--parity takes a number of pairs (0: no check), not {parity_pairs}")
+    for need in ("run.json", "adapter/adapter_config.json"):
+        if not (run_dir / need).is_file():
+            raise ExportError(f"{run_dir} has no {need}: name a finished `ara train` run "
+                              "folder (one with adapter/)")

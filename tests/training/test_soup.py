@@ -142,3 +142,20 @@ def test_ara_soup_makes_a_run_folder_that_export_can_read(tmp_path):
     assert done.exit_code == 0, done.output
     record = json.loads((tmp_path / "soup2" / "run.json").read_text())
     assert record["soup"]["rank"] == 8 and record["reduced"]["from_rank"] == 5
+
+
+def test_export_refuses_at_once_what_would_fail_after_minutes(tmp_path):
+    """Tests `ara export` on a folder that is no finished run, an unknown type and a
+    negative parity: each is an error before any merging."""
+    from conftest import run_ara
+
+    adapter(tmp_path / "run" / "adapter", seed=1, r=4, alpha=8)
+    (tmp_path / "run" / "run.json").write_text(json.dumps({"base_model": {"path": "tiny"}}))
+    for args, message in [(["--run", str(tmp_path)], "has no run.json"),
+                          (["--run", str(tmp_path / "run"), "--quant", "f16,q3"],
+                           "unknown quantization ['q3']"),
+                          (["--run", str(tmp_path / "run"), "--parity", "-3"],
+                           "--parity takes a number of pairs")]:
+        out = run_ara("export", *args)
+        assert out.returncode == 2 and message in out.stderr, out.stderr
+    assert not (tmp_path / "run" / "export").exists()
