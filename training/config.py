@@ -228,11 +228,3 @@ def _checked(cls, data: dict) -> dict:
         if key not in known:
             raise ConfigError(f"unknown key {key}. {did_you_mean(key, known)}")
     return data
-
-
-def whole_checkpoints(out: Path) -> list[Path]:
-    """The whole checkpoints of run folder ``out`` (``step.json`` is written last, so a
-    checkpoint a kill cut short has none), oldest first."""
-    return sorted((p for p in (out / "checkpoints").glob("step_*")
-                   if p.joinpath("step.json").is_file()),
-                  key=lambda p: int(p.name.split("_")[1]))

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import random
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import torch
 
@@ -177,3 +178,11 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
     logits = out.logits[0]  # (answer tokens, vocab)
     total = torch.nn.functional.cross_entropy(logits.float(), gathered, reduction="sum")
     return total, int(gathered.numel())
+
+
+def own_pairs(path: str) -> list:
+    """A user's pairs file as training records of the source ``pairs``."""
+    from ara.eval.translate.request_file import read_pairs
+    from ara.eval.translate.translator import TranslatorConfig
+
+    return [replace(r, source="pairs") for r in read_pairs(Path(path), TranslatorConfig())]

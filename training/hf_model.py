@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from functools import lru_cache
 from pathlib import Path
 
 from ara import __version__
@@ -96,3 +97,24 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     shutil.rmtree(out, ignore_errors=True)
     staging.rename(out)
     return out
+
+
+def load_tokenizer(model_dir: str | Path):
+    """The tokenizer of a model folder, read once per process while its files are
+    unchanged: parsing Gemma's 262k vocabulary takes seconds, and a recipe's stages (and
+    the tests' many short runs) read the same one. Callers only read it (encode, pad,
+    save a copy beside an adapter)."""
+    return _tokenizer(str(model_dir), _stamp(model_dir))
+
+
+@lru_cache(maxsize=2)
+def _tokenizer(model_dir: str, stamp: tuple):
+    """``stamp`` keys the cache to the files, so a rewritten folder is read again."""
+    from transformers import AutoTokenizer
+
+    return AutoTokenizer.from_pretrained(model_dir, local_files_only=True)
+
+
+def _stamp(model_dir) -> tuple:
+    return tuple(sorted((f.name, f.stat().st_mtime_ns, f.stat().st_size)
+                        for f in Path(model_dir).glob("*token*")))

@@ -17,7 +17,6 @@ import random
 import shutil
 import time
 import warnings
-from functools import lru_cache
 from pathlib import Path
 
 import torch
@@ -26,16 +25,24 @@ from tqdm import tqdm
 
 from ara import __version__
 from ara.errors import ConfigError
-from ara.provenance import differing
-from ara.training.config import BOOKKEEPING, TrainConfig, whole_checkpoints
+from ara.training.config import TrainConfig
 from ara.training.dataset import (
     answer_loss_sum,
     batch_shots,
     batches,
     collate,
     encode,
+    own_pairs,
     repeat_sources,
     shot_rng,
+)
+from ara.training.hf_model import load_tokenizer
+from ara.training.run_folder import (
+    adapter_identity,
+    log_summary,
+    refuse_changed_config,
+    refuse_changed_data,
+    whole_checkpoints,
 )
 
 
@@ -54,7 +61,7 @@ class LoRAFinetuneRecipe:
         if self.out.joinpath("run.json").exists() and not resume:
             raise ConfigError(f"{self.out} already holds a run: pass --resume or another out")
         if resume and self.out.joinpath("run.json").exists():
-            _refuse_changed_config(self.out / "run.json", config)
+            refuse_changed_config(self.out / "run.json", config)
         if config.init_adapter and not Path(config.init_adapter_folder,
                                             "adapter_config.json").is_file():
             raise ConfigError(
@@ -78,7 +85,7 @@ class LoRAFinetuneRecipe:
         self.model_dir = self._base_model_dir()
         # The tokenizer before the data (examples are token ids), the data before the
         # schedule (its length sets the number of steps).
-        self.tokenizer = _tokenizer(str(self.model_dir), _stamp(self.model_dir))
+        self.tokenizer = load_tokenizer(self.model_dir)
         # The first use of a registered split prepares it; one process writes it.
         with self.accelerator.main_process_first():
             self.train_records, self.split = self._load_data()
@@ -117,7 +124,6 @@ class LoRAFinetuneRecipe:
 
     def _load_data(self):
         from ara.data import load_or_prepare, load_split
-        from ara.provenance import sha256_file
 
         data = self.config.data
         # The registered version is deterministic: a fresh clone prepares it rather than
@@ -125,17 +131,7 @@ class LoRAFinetuneRecipe:
         split = (load_or_prepare(data.split, data.seed) if data.version is None
                  else load_split(data.split, data.seed, version=data.version))
         if self.resume and self.out.joinpath("run.json").exists():
-            started = json.loads(self.out.joinpath("run.json").read_text())["data"]["version"]
-            if started != split.version:
-                raise ConfigError(
-                    f"--resume: {self.out} was started on {data.split} version {started}, "
-                    f"but this release loads {split.version}; pin data.version: {started} "
-                    "in the config")
-            pairs = json.loads(self.out.joinpath("run.json").read_text())["data"].get(
-                "pairs_sha256")
-            if data.pairs and pairs != sha256_file(data.pairs):
-                raise ConfigError(f"--resume: {data.pairs} changed since {self.out} started; "
-                                  "train the new pairs into another out folder")
+            refuse_changed_data(self.out / "run.json", data, split.version)
         records = [r for f in self.config.data.forms for r in split.records("train", f)]
         if self.config.data.limit:
             records = records[: self.config.data.limit]
@@ -177,7 +173,7 @@ class LoRAFinetuneRecipe:
                             if self.config.data.pairs else {})},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "processes": self.accelerator.num_processes,
-                "init_adapter": _adapter_identity(self.config.init_adapter_folder),
+                "init_adapter": adapter_identity(self.config.init_adapter_folder),
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
 
@@ -344,27 +340,6 @@ class LoRAFinetuneRecipe:
         return report
 
 
-#: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
-#: and those that leave the adapter as it is.
-_RESUMABLE_KEYS = BOOKKEEPING | {"max_steps"}
-
-
-@lru_cache(maxsize=2)
-def _tokenizer(model_dir: str, stamp: tuple):
-    """The base model's tokenizer, read once per process: parsing Gemma's 262k vocabulary
-    takes seconds, and a recipe's stages (and a test's many short runs) read the same one.
-    ``stamp`` keys the cache to the files, so a rewritten folder is read again. Training
-    only reads it (encodes, pads, saves a copy beside each adapter)."""
-    from transformers import AutoTokenizer
-
-    return AutoTokenizer.from_pretrained(model_dir, local_files_only=True)
-
-
-def _stamp(model_dir) -> tuple:
-    return tuple(sorted((f.name, f.stat().st_mtime_ns, f.stat().st_size)
-                        for f in Path(model_dir).glob("*token*")))
-
-
 def _warm_started(base, folder: str, lora):
     """``base`` with the trainable adapter saved in ``folder``, checked against ``lora``:
     a warm start whose shape differs from the config would record one thing and train
@@ -388,67 +363,13 @@ def _warm_started(base, folder: str, lora):
     return model
 
 
-def own_pairs(path: str) -> list:
-    """A user's pairs file as training records of the source ``pairs``."""
-    from dataclasses import replace
-
-    from ara.eval.translate.request_file import read_pairs
-    from ara.eval.translate.translator import TranslatorConfig
-
-    return [replace(r, source="pairs") for r in read_pairs(Path(path), TranslatorConfig())]
-
-
-def _adapter_identity(folder: str | Path | None) -> dict | None:
-    """Where a warm start came from: the folder and its weights' hash."""
-    if not folder:
-        return None
-    from ara.provenance import sha256_file
-
-    weights = sorted(Path(folder).glob("adapter_model.*"))
-    digest = sha256_file(weights[0]) if weights else None
-    return {"path": str(folder), "sha256": digest}
-
-
-def _refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
-    """A resumed run continues the same training: the same data, schedule and model.
-    The data version is compared as loaded (``_load_data``), not as written: pinning
-    the version a run started on unpinned is no change."""
-    started, now = json.loads(run_json.read_text())["config"], config.to_dict()
-    started["data"] = {**started["data"], "version": None}
-    now["data"] = {**now["data"], "version": None}
-    changed = {k: values for k, values in differing(started, now).items()
-               if k not in _RESUMABLE_KEYS}
-    if changed:
-        detail = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
-        may = ", ".join(sorted(_RESUMABLE_KEYS))
-        raise ConfigError(
-            f"--resume: the config differs from the one {run_json.parent} was started with "
-            f"({detail}); resume with the same config (only {may} may change), or train "
-            "into another out folder")
-
-
-def _log_summary(path: Path) -> dict:
-    """The first and last loss and the seconds spent in steps, over every session of the run: a
-    session killed outright records no wall time of its own, but its steps are logged
-    (a step redone after a resume counts again, as the time was spent)."""
-    rows = []
-    for line in path.read_text().splitlines() if path.is_file() else ():
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError:  # the half-written line of a session killed mid-write
-            continue
-    return {"first_loss": rows[0]["loss"] if rows else None,
-            "last_loss": rows[-1]["loss"] if rows else None,
-            "step_seconds": round(sum(r["seconds"] for r in rows), 1)}
-
-
 def run_training(config: TrainConfig, resume: bool = False) -> dict:
     """Train, save the adapter, run the held-out check; returns a summary."""
     recipe = LoRAFinetuneRecipe(config, resume)
     recipe.setup()
     recipe.train()
     recipe.save_checkpoint()
-    summary = {"steps": recipe.step, **_log_summary(recipe.out / "train_log.jsonl")}
+    summary = {"steps": recipe.step, **log_summary(recipe.out / "train_log.jsonl")}
     if recipe.accelerator.is_main_process:  # one adapter and one check, whatever the processes
         summary["adapter"] = str(recipe.save_adapter())
         if config.eval_pairs:

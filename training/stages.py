@@ -37,7 +37,8 @@ from pathlib import Path
 from typing import Any
 
 from ara.errors import ConfigError, did_you_mean
-from ara.training.config import BOOKKEEPING, TrainConfig, whole_checkpoints
+from ara.training.config import BOOKKEEPING, TrainConfig
+from ara.training.run_folder import whole_checkpoints
 
 KINDS = ("train", "soup", "export")
 # Where a rebuilt training stage's old folder goes: hours of training are not deleted by
