@@ -38,7 +38,7 @@ from typing import Any
 
 from ara.errors import ConfigError, did_you_mean
 from ara.training.config import BOOKKEEPING, TrainConfig
-from ara.training.run_folder import whole_checkpoints
+from ara.training.run_folder import adapter_identity, whole_checkpoints
 
 KINDS = ("train", "soup", "export")
 # Where a rebuilt training stage's old folder goes: hours of training are not deleted by
@@ -153,11 +153,25 @@ class StagedRecipe:
                 # registers another: a stage trained on the old one is stale.
                 settings["data"] = {**settings["data"],
                                     "version": config.data.resolved_version()}
+                # What a file holds, not its name: a user's pairs edited, or a warm start
+                # from an adapter a release replaced (init_adapter: finetuned), is another
+                # stage. (Keys only where set, so other stages keep their fingerprints.)
+                if config.data.pairs:
+                    settings["data"]["pairs_sha256"] = _file_hash(config.data.pairs)
+                if config.init_adapter and not stage.inputs:
+                    settings["init_adapter_sha256"] = (
+                        adapter_identity(config.init_adapter_folder) or {}).get("sha256")
             blob = json.dumps({"kind": stage.kind, "settings": settings,
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)
             prints[stage.name] = hashlib.sha256(blob.encode()).hexdigest()[:16]
         return prints
+
+
+def _file_hash(path: str) -> str | None:
+    from ara.provenance import sha256_file
+
+    return sha256_file(path) if Path(path).is_file() else None
 
 
 def _stage(item: Any) -> Stage:

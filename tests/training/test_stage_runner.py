@@ -84,6 +84,26 @@ def test_a_stage_trained_on_the_registered_data_is_stale_once_another_version_is
                                       strict=True))
 
 
+def test_a_stage_is_what_its_files_hold_not_their_names(tmp_path):
+    """Tests that a user's pairs file edited, or the adapter a stage warm-starts from
+    replaced, makes another stage, though the config reads the same."""
+    pairs = tmp_path / "pairs.jsonl"
+    pairs.write_text('{"nl": "go to the dock", "stl": "F(go_dock)", "aps": ["go_dock"]}\n')
+    warm = tmp_path / "warm"
+    warm.mkdir()
+    (warm / "adapter_config.json").write_text("{}")
+    (warm / "adapter_model.safetensors").write_bytes(b"one")
+    recipe = StagedRecipe.from_dict({"out": str(tmp_path / "out"), "defaults": {
+        "init_adapter": str(warm), "data": {"pairs": str(pairs)}},
+        "stages": [{"name": "a", "train": {}}, {"name": "b", "from": "a", "train": {}}]})
+    before = recipe.fingerprints()
+    pairs.write_text(pairs.read_text() * 2)
+    edited = recipe.fingerprints()
+    (warm / "adapter_model.safetensors").write_bytes(b"two")
+    assert len({before["a"], edited["a"], recipe.fingerprints()["a"]}) == 3
+    assert before["b"] != edited["b"]  # b reads a
+
+
 @pytest.mark.parametrize("stages, message", [
     ([{"name": "a", "train": {}, "from": "b"}, {"name": "b", "train": {}}],
      "reads 'b', which is not a stage before it"),
