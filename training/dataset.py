@@ -109,7 +109,8 @@ def batch_shots(pool: Sequence[Record], batch: Sequence[Record], counts: Sequenc
     taken = {(r.source, r.row) for r in batch}
     eligible = len({(r.source, r.row) for r in pool} - taken)
     if k > eligible:
-        raise ValueError(f"asked for {k} shots; only {eligible} training pairs are eligible")
+        raise ConfigError(f"asked for {k} shots; only {eligible} training pairs are eligible "
+                          "beside the batch: lower data.shots or train on more records")
     shots: list[Shot] = []
     while len(shots) < k:
         r = pool[rng.randrange(len(pool))]

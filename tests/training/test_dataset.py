@@ -39,7 +39,7 @@ def test_the_count_is_drawn_from_the_list_and_seeded():
 
 
 def test_too_many_shots_for_the_pool_is_a_clear_error():
-    with pytest.raises(ValueError, match="only 28 training pairs are eligible"):
+    with pytest.raises(ConfigError, match="only 28 training pairs are eligible"):
         batch_shots(POOL, POOL[:4], [29], random.Random(0))
 
 
