@@ -192,6 +192,23 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
     return record
 
 
+def check_soup(parts: int, weights: list | None, rank: int | None, noun: str = "run") -> None:
+    """A soup's settings, before anything is read: ``weights`` one positive number per
+    part, at least two parts or one and a ``rank`` (a positive whole number)."""
+    if weights is not None:
+        if not isinstance(weights, list) or len(weights) != parts:
+            count = len(weights) if isinstance(weights, list) else weights
+            raise ConfigError(f"{count} weights for {parts} {noun}s: one per {noun}, in order")
+        for w in weights:
+            if not isinstance(w, (int, float)) or not math.isfinite(w) or w <= 0:
+                raise ConfigError(f"a soup weight must be a positive number, got {w!r}")
+    if parts < 2 and rank is None:
+        raise ConfigError(f"a soup needs at least two {noun}s (or one and a rank to reduce "
+                          "it to)")
+    if rank is not None and (not isinstance(rank, int) or rank < 1):
+        raise ConfigError(f"a reduced rank is a positive whole number, got {rank!r}")
+
+
 def soup_runs(runs: list[Path], weights: list[float] | None, out: Path,
               rank: int | None = None) -> dict:
     """Average finished ``ara train`` runs into the run folder ``out`` (``adapter/``,
@@ -201,11 +218,8 @@ def soup_runs(runs: list[Path], weights: list[float] | None, out: Path,
     data version, which export needs) with the soup's own parts under ``soup`` and
     ``reduced``.
     """
+    check_soup(len(runs), weights, rank)
     weights = list(weights or [1.0] * len(runs))
-    if len(weights) != len(runs):
-        raise ConfigError(f"{len(weights)} weights for {len(runs)} runs: one per run, in order")
-    if len(runs) < 2 and rank is None:
-        raise ConfigError("a soup needs at least two runs (or one and a rank to reduce it to)")
     for run in runs:
         if not (Path(run) / "run.json").is_file():
             raise ConfigError(f"{run} is not an `ara train` run folder (no run.json)")

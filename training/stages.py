@@ -39,6 +39,7 @@ from typing import Any
 from ara.errors import ConfigError, did_you_mean
 from ara.training.config import BOOKKEEPING, TrainConfig
 from ara.training.run_folder import adapter_identity, whole_checkpoints
+from ara.training.soup import check_soup
 
 KINDS = ("train", "soup", "export")
 # Where a rebuilt training stage's old folder goes: hours of training are not deleted by
@@ -73,8 +74,6 @@ class Stage:
                               "stages' old folders; choose another")
         if self.kind not in KINDS:
             raise ConfigError(f"stage {self.name}: kind {self.kind!r} is not one of {KINDS}")
-        if self.kind == "soup" and len(self.inputs) < 2 and self.settings.get("rank") is None:
-            raise ConfigError(f"stage {self.name}: a soup needs two stages, or one and a rank")
         if self.kind == "export" and len(self.inputs) != 1:
             raise ConfigError(f"stage {self.name}: export names exactly one stage")
 
@@ -187,11 +186,27 @@ def _stage(item: Any) -> Stage:
         settings, source = item.pop("train") or {}, item.pop("from", None)
         inputs = (source,) if source else ()
     elif kind == "soup":
-        inputs = tuple(item.pop("soup") or ())
+        parts = item.pop("soup") or ()
+        if not isinstance(parts, list) or not all(isinstance(p, str) for p in parts):
+            raise ConfigError(f"stage {name}: soup lists the stages it averages, "
+                              f"e.g. [refine-a, refine-b]; got {parts!r}")
+        inputs = tuple(parts)
         settings = {k: item.pop(k) for k in ("weights", "rank") if k in item}
+        try:
+            check_soup(len(inputs), settings.get("weights"), settings.get("rank"), "stage")
+        except ConfigError as err:
+            raise ConfigError(f"stage {name}: {err}") from None
     else:
-        inputs = (item.pop("export"),)
+        source = item.pop("export")
+        if not isinstance(source, str):
+            raise ConfigError(f"stage {name}: export names one stage, e.g. soup; "
+                              f"got {source!r}")
+        inputs = (source,)
         settings = {k: item.pop(k) for k in ("parity",) if k in item}
+        parity = settings.get("parity", 20)
+        if not isinstance(parity, int) or parity < 0:
+            raise ConfigError(f"stage {name}: parity is a number of test pairs (0: no "
+                              f"check), got {parity!r}")
     if item:
         raise ConfigError(f"stage {name}: unknown keys {sorted(item)} for a {kind} stage")
     if not isinstance(settings, dict):
