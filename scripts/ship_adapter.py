@@ -10,9 +10,8 @@ into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT
 (the run, the export with its parity, the held-out check) and the parity
 of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
 merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
-`--min-agreement` nothing is shipped. Compare the candidate on the blind sets
-(`VARIANTS=C REPAIR=8 scripts/eval_generalization.sh lora:EXPORT/lora.gguf NAME`, `ara eval
-diff` against docs/results/generalization/shipped-repair8) first.
+`--min-agreement` nothing is shipped. Judge the candidate against the shipped file first
+(`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`).
 """
 
 from __future__ import annotations
