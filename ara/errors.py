@@ -67,3 +67,13 @@ def did_you_mean(name: str, available: Iterable[str]) -> str:
     close = difflib.get_close_matches(name, choices, n=1)
     hint = f"Did you mean '{close[0]}'? " if close else ""
     return f"{hint}Available: {', '.join(choices)}."
+
+
+def refuse_unknown_keys(data: Iterable[str], known: Iterable[str], where: str = "") -> None:
+    """Raise :class:`ConfigError` on the first key of ``data`` not in ``known``, naming it
+    under ``where`` (``"lora."``) with the closest known key: a misspelt setting would
+    otherwise be dropped without a word."""
+    known = set(known)
+    for key in data:
+        if key not in known:
+            raise ConfigError(f"unknown key {where}{key}. {did_you_mean(str(key), known)}")

@@ -21,7 +21,7 @@ from typing import Protocol
 from ara import __version__
 from ara.data import Record
 from ara.data.store import FORMS, SPLITS
-from ara.errors import ConfigError, did_you_mean
+from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
 from ara.eval.translate.answering import Answer
 from ara.eval.translate.prompt import Shot, sample_shots
 from ara.eval.translate.repair import RepairConfig, translate_repaired
@@ -173,10 +173,7 @@ class AblationConfig:
 
     @classmethod
     def from_dict(cls, data: dict) -> AblationConfig:
-        known = {f.name for f in fields(cls)} | {"repair_by", "repair_doubt"}
-        unknown = set(data) - known
-        if unknown:
-            raise ConfigError(f"unknown keys {sorted(unknown)}; known: {sorted(known)}")
+        refuse_unknown_keys(data, {f.name for f in fields(cls)} | {"repair_by", "repair_doubt"})
         data = dict(data)
         # Runs repaired before repair by edits, or of doubted answers, existed say so.
         by, doubt = data.pop("repair_by", "samples"), data.pop("repair_doubt", 0.0)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import yaml
 
-from ara.errors import ConfigError, did_you_mean
+from ara.errors import ConfigError, refuse_unknown_keys
 from ara.eval.translate.models import SHIPPED
 
 
@@ -21,10 +21,7 @@ def _build(cls, data: dict | None, where: str):
     data = data or {}
     if not isinstance(data, dict):
         raise ConfigError(f"{where} must be a mapping, got {type(data).__name__}")
-    known = {f.name for f in fields(cls)}
-    for key in data:
-        if key not in known:
-            raise ConfigError(f"unknown key {where}.{key}. {did_you_mean(key, known)}")
+    refuse_unknown_keys(data, {f.name for f in fields(cls)}, f"{where}.")
     return cls(**data)
 
 
@@ -223,8 +220,5 @@ class TrainConfig:
 
 
 def _checked(cls, data: dict) -> dict:
-    known = {f.name for f in fields(cls)} - {"lora", "optim", "data"}
-    for key in data:
-        if key not in known:
-            raise ConfigError(f"unknown key {key}. {did_you_mean(key, known)}")
+    refuse_unknown_keys(data, {f.name for f in fields(cls)} - {"lora", "optim", "data"})
     return data

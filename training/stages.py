@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ara.errors import ConfigError, did_you_mean
+from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
 from ara.training.config import BOOKKEEPING, TrainConfig
 from ara.training.run_folder import adapter_identity, whole_checkpoints
 from ara.training.soup import check_soup
@@ -113,10 +113,7 @@ class StagedRecipe:
 
     @classmethod
     def from_dict(cls, data: dict) -> StagedRecipe:
-        known = {"out", "defaults", "stages"}
-        for key in data:
-            if key not in known:
-                raise ConfigError(f"unknown key {key}. {did_you_mean(key, known)}")
+        refuse_unknown_keys(data, {"out", "defaults", "stages"})
         if "out" not in data or not isinstance(data.get("stages"), list):
             raise ConfigError("a recipe needs `out` and a list of `stages`")
         return cls(Path(data["out"]), dict(data.get("defaults") or {}),
