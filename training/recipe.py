@@ -136,7 +136,13 @@ class LoRAFinetuneRecipe:
         if self.config.data.limit:
             records = records[: self.config.data.limit]
         if data.pairs:
-            records += [r for r in own_pairs(data.pairs) if r.form in data.forms]
+            mine = own_pairs(data.pairs)
+            kept = [r for r in mine if r.form in data.forms]
+            if mine and not kept:
+                forms = sorted({r.form for r in mine})
+                raise ConfigError(f"{data.pairs}: its {len(mine)} pairs are {forms}, and "
+                                  f"data.forms trains on {list(data.forms)}: add {forms[0]}")
+            records += kept
         return repeat_sources(records, self.config.data.repeat), split
 
     def _lora_model(self):

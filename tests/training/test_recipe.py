@@ -305,6 +305,11 @@ def test_your_own_pairs_join_the_training_records(tiny_gemma_dir, tmp_path):
     assert len(run["data"]["pairs_sha256"]) == 64
     shipped = TrainConfig.from_dict({**config.to_dict(), "init_adapter": "finetuned"})
     assert (shipped.init_adapter_folder / "adapter_config.json").is_file()
+    # Pairs of a form the run does not train on would be dropped without a word.
+    lifted_only = tiny_config(tiny_gemma_dir, tmp_path / "run2", max_steps=1,
+                              data={"forms": ["lifted"], "limit": 4, "pairs": str(pairs)})
+    with pytest.raises(ConfigError, match=r"its 2 pairs are \['grounded'\].*add grounded"):
+        LoRAFinetuneRecipe(lifted_only).setup()
 
 
 def test_a_lab_pairs_config_names_a_file_that_exists():
