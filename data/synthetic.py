@@ -105,7 +105,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.8.0"
+SYNTHETIC_VERSION = "3.9.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -338,10 +338,11 @@ def _lifted_atom(rng: random.Random) -> Callable[[str], str]:
 
 def _word(f: Formula, rng: random.Random, mode: str, say, is_action,
           is_lasting=lambda name: False, say_negated=lambda name: None,
-          say_place=lambda name: None) -> str:
+          say_place=lambda name: None, in_words: bool = False) -> str:
     return realize(f, Realizer(rng=rng, mode=mode, unit=rng.randrange(len(UNITS)),
                                say_atom=say, is_action=is_action, is_lasting=is_lasting,
-                               say_negated=say_negated, say_place=say_place))
+                               say_negated=say_negated, say_place=say_place,
+                               in_words=in_words))
 
 
 @dataclass(frozen=True)
@@ -359,6 +360,9 @@ class Roles:
     #: or kept false by ``G`` (``G(!a)``, ``G(c -> !a)``), which may be being somewhere
     #: ("go to the dock and stay there", "stay out of the kitchen").
     places: frozenset[str] = frozenset()
+    #: What ``G`` keeps true (``a`` in ``G(a)``, ``G[0,n](a)``) or ``U`` keeps until
+    #: (``a`` in ``a U b``), and nothing else: a kept state ("keep the valve closed").
+    kept: frozenset[str] = frozenset()
 
 
 def roles_of(f: Formula) -> Roles:
@@ -406,8 +410,23 @@ def roles_of(f: Formula) -> Roles:
                 forbidden.add(kept.arg.name)
     # "never pick up the box while the alarm is on": any action may be forbidden
     states -= forbidden
+    taken = conditions | states | triggers | places
     return Roles(frozenset(conditions - triggers), frozenset(states - conditions),
-                 frozenset(triggers), frozenset(places - conditions - states - triggers))
+                 frozenset(triggers), frozenset(places - conditions - states - triggers),
+                 frozenset(_kept(f, occurrences) - taken))
+
+
+def _kept(f: Formula, occurrences: Counter) -> set[str]:
+    """The propositions whose every occurrence ``G`` keeps true, or ``U`` keeps until
+    its right side: not a ``G`` under ``F`` ("for good" says the state is reached)."""
+    settled = {id(n.arg) for n in walk(f) if isinstance(n, Eventually)}
+    settled |= {id(g) for n in walk(f) if isinstance(n, Eventually) and isinstance(n.arg, And)
+                for g in n.arg.args}  # "at some point a, and from then on b for good"
+    spots = Counter(n.arg.name for n in walk(f) if isinstance(n, Always)
+                    and id(n) not in settled and isinstance(n.arg, Atom))
+    spots.update(n.lhs.name for n in walk(f) if isinstance(n, Until)
+                 and isinstance(n.lhs, Atom))
+    return {name for name, count in spots.items() if count == occurrences[name]}
 
 
 def pair(rng: random.Random, s: SynthSettings, mode: str,
@@ -435,7 +454,8 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
 
     props: list[Proposition] = draw_propositions(
         rng, len(used), conditions=indices(roles.conditions), states=indices(roles.states),
-        triggers=indices(roles.triggers), places=indices(roles.places))
+        triggers=indices(roles.triggers), places=indices(roles.places),
+        kept=indices(roles.kept))
     by_x = dict(zip(used, props, strict=True))
     grounded = rename_atoms(f, {x: p.name for x, p in by_x.items()})
     by_name = {p.name: p for p in props}
@@ -444,7 +464,7 @@ def pair(rng: random.Random, s: SynthSettings, mode: str,
     grounded_nl = _word(grounded, rng, mode, phrase.__getitem__,
                         lambda name: by_name[name].action,
                         lambda name: by_name[name].lasting, negated.get,
-                        lambda name: by_name[name].place)
+                        lambda name: by_name[name].place, in_words=True)
     return lifted, lifted_nl, grounded, grounded_nl
 
 

@@ -129,6 +129,26 @@ PLACE_STATES = (("in", ("the robot is in the {x}", "you are in the {x}")),
                 ("person_in", ("a person is in the {x}", "someone is in the {x}")))
 OBJECT_STATES = (("holding", ("the robot is holding the {x}", "the {x} is in the gripper")),
                  ("seen", ("the {x} is visible", "the robot sees the {x}")))
+#: States a robot keeps things in ("keep the valve closed", ``valve_closed``): said as a
+#: lasting action where ``G`` keeps them, as a clause ("the valve is closed") where they
+#: are a condition. People say "keep X open" far more often than "X is open at all
+#: times", and before 3.9 "keep" meant only "keep returning" (``G(F(.))``) in training.
+SWITCHED = ("fan", "heater", "pump", "lamp", "printer", "projector", "oven", "vacuum",
+            "microwave", "washing_machine", "lights", "engine", "camera", "conveyor")
+OPENED = ("valve", "window", "drawer", "lid", "hatch", "cabinet", "tap", "door", "gate",
+          "vents", "gripper")
+LOCKED = ("cabinet", "door", "hatch", "locker", "gate")
+KEPT_THINGS = (
+    ("area_clear", "the area", "clear"), ("path_clear", "the path", "clear"),
+    ("floor_dry", "the floor", "dry"), ("arm_still", "the arm", "still"),
+    ("speed_low", "the speed", "low"), ("volume_low", "the volume", "low"),
+    ("arm_raised", "the arm", "raised"), ("lights_dimmed", "the lights", "dimmed"),
+    ("tank_full", "the tank", "full"), ("battery_charged", "the battery", "charged"),
+    ("aisle_clear", "the aisle", "clear"), ("exit_clear", "the exit", "clear"),
+    ("brakes_on", "the brakes", "on"), ("table_clean", "the table", "clean"),
+)
+KEPT_PHRASES = ("keep {x} {st}", "leave {x} {st}", "make sure {x} {stays} {st}",
+                "{x} must stay {st}")
 #: Words for a place's negation: "stay out of the kitchen" is ``!in_kitchen``.
 NEGATED = {"in": ("stay out of the {x}", "keep out of the {x}", "stay away from the {x}"),
            "at": ("stay away from the {x}", "keep away from the {x}")}
@@ -160,12 +180,14 @@ BEING_AT = frozenset({"at", "in"})
 def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = frozenset(),
                       states: frozenset[int] = frozenset(),
                       triggers: frozenset[int] = frozenset(),
-                      places: frozenset[int] = frozenset()) -> list[Proposition]:
+                      places: frozenset[int] = frozenset(),
+                      kept: frozenset[int] = frozenset()) -> list[Proposition]:
     """``k`` propositions with distinct names, mixing actions and conditions; the ones
     at the indices in ``conditions`` are conditions, those in ``states`` a condition or
     a lasting action, those in ``triggers`` a condition or an achievement said as an
     event, half and half; those in ``places`` (and none of the others) are being
-    somewhere half the time."""
+    somewhere half the time, those in ``kept`` (and none of the others) a kept state
+    ("keep the valve closed") half the time."""
     found: dict[str, Proposition] = {}
     while len(found) < k:
         i = len(found)
@@ -177,6 +199,8 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_lasting(rng)
         elif i in places and rng.random() < 0.5:
             prop = _draw_being_at(rng)
+        elif i in kept and rng.random() < 0.5:
+            prop = _draw_kept(rng, as_clause=False)
         else:
             prop = _draw_one(rng)
         found.setdefault(prop.name, prop)
@@ -184,6 +208,8 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
 
 
 def _draw_lasting(rng: random.Random) -> Proposition:
+    if rng.random() < 0.4:
+        return _draw_kept(rng, as_clause=False)
     kind = rng.random()
     if kind < 0.45:
         phrases = dict(PLACE_VERBS)["at"]
@@ -195,6 +221,30 @@ def _draw_lasting(rng: random.Random) -> Proposition:
         return _about("hold", phrases, name, words, action=True)
     verb = "wait" if kind < 0.93 else "stop"
     return Proposition(verb, dict(STANDALONE_ACTIONS)[verb], action=True, lasting=True)
+
+
+def kept_states() -> tuple[tuple[str, str, str], ...]:
+    """Every (name, subject, state) :data:`KEPT_PHRASES` may say."""
+    switched = tuple((f"{x}_{st}", x, st) for x in SWITCHED for st in ("on", "off"))
+    opened = tuple((f"{x}_{st}", x, st) for x in OPENED for st in ("open", "closed"))
+    locked = tuple((f"{x}_locked", x, "locked") for x in LOCKED)
+    things = tuple((f"{name.replace(' ', '_')}", f"the {x.replace('_', ' ')}", st)
+                   for name, x, st in switched + opened + locked)
+    return things + KEPT_THINGS
+
+
+def _draw_kept(rng: random.Random, as_clause: bool) -> Proposition:
+    """A state kept ("keep the valve closed"), or said as a clause ("the valve is
+    closed") where it is a condition."""
+    name, subject, state = rng.choice(kept_states())
+    plural = subject.endswith("s") and not subject.endswith("ss")
+    if as_clause:
+        return Proposition(name, (f"{subject} {'are' if plural else 'is'} {state}",),
+                           action=False)
+    phrases = tuple(dict.fromkeys(p.format(x=subject, st=state,
+                                           stays="stay" if plural else "stays")
+                                  for p in KEPT_PHRASES))
+    return Proposition(name, phrases, action=True, lasting=True)
 
 
 def _draw_being_at(rng: random.Random) -> Proposition:
@@ -225,6 +275,8 @@ def _draw_event(rng: random.Random) -> Proposition:
 
 
 def _draw_condition(rng: random.Random) -> Proposition:
+    if rng.random() < 0.2:
+        return _draw_kept(rng, as_clause=True)
     kind = rng.random()
     if kind < 0.5:
         name, phrases = rng.choice(CONDITIONS)

@@ -281,6 +281,9 @@ class Realizer:
             ``at_charging_station``), else ``None``: ``F(G(a))`` may then be said "go to
             the charging station and stay there" and ``G(F(a))`` "keep coming back to
             it"; sampled sentences only, half the time.
+        in_words: Whether propositions are said in words (a clause, a command) rather
+            than by name: then ``a U b`` says ``a`` only before "until" ("the door is
+            open until ...", not "keep the door is open until ...").
     """
 
     rng: random.Random | None = None
@@ -291,6 +294,7 @@ class Realizer:
     is_lasting: Callable[[str], bool] = field(default=lambda name: False)
     say_negated: Callable[[str], str | None] = field(default=lambda name: None)
     say_place: Callable[[str], str | None] = field(default=lambda name: None)
+    in_words: bool = False
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -399,9 +403,14 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
             text = r.pick(key, used, first=comma, allow=allow, a=text, b=operand(arg))
         return text
     if isinstance(f, Until):
+        # A proposition said in words reads only before "until": not "keep hold the box
+        # until ...", "the door is open holds until ...".
+        worded = isinstance(f.lhs, Atom) and r.in_words
+        allow = (lambda p: p.startswith(("{a} until", "{a} up to"))) if worded else None
         if f.interval is None:
-            return r.pick("U()" if embedded else "U", used, a=sub(f.lhs), b=sub(f.rhs))
-        return _timed("U", f.interval, r, used, a=sub(f.lhs), b=sub(f.rhs))
+            return r.pick("U()" if embedded else "U", used, allow=allow, a=sub(f.lhs),
+                          b=sub(f.rhs))
+        return _timed("U", f.interval, r, used, allow=allow, a=sub(f.lhs), b=sub(f.rhs))
     op = "->" if isinstance(f, Implies) else "<->"
     if embedded:
         return r.pick(op + "()", used, a=sub_now(f.lhs), b=sub_now(f.rhs))

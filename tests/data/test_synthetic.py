@@ -25,6 +25,7 @@ from ara.data.vocabulary import (
     OBJECT_VERBS,
     PLACE_VERBS,
     STANDALONE_ACTIONS,
+    kept_states,
 )
 from ara.errors import ConfigError
 from ara.grammars import Syntax, parse
@@ -193,6 +194,42 @@ def test_roles_of_a_response_with_an_action_trigger():
     assert roles.conditions == {"c", "e", "f"} and roles.states == {"g"}
     # A proposition said elsewhere too keeps one wording: a condition there
     assert roles_of(parse("G(a -> F(b)) & F(a)")).triggers == frozenset()
+
+
+def test_what_g_keeps_true_may_be_a_kept_state(train_records):
+    """Tests "keep the valve closed" for G(valve_closed): people say what G keeps true
+    with "keep", which training had taught only as "keep returning" (G(F(.))). The
+    same names are conditions said as clauses ("whenever the valve is closed")."""
+    assert roles_of(parse("G(a) & (b U c) & F(G(d)) & F(e & G(f)) & G(g -> h)")).kept == {
+        "a", "b"}
+    assert roles_of(parse("G(a) & F(a)")).kept == frozenset()  # one wording per name
+    kept_names = {name for name, _, _ in kept_states()}
+    said_kept, said_as_clause = [], []
+    for r in train_records:
+        if r.form != "grounded":
+            continue
+        for n in walk(r.formula):
+            if isinstance(n, Always) and isinstance(n.arg, Atom) and n.arg.name in kept_names \
+                    and re.search(r"\b(keep|leave|must stay|stays?)\b", r.nl):
+                said_kept.append(r)
+            if isinstance(n, Implies) and isinstance(n.lhs, Atom) \
+                    and n.lhs.name in kept_names:
+                said_as_clause.append(r)
+                assert re.search(r"\b(is|are)\b", r.nl), r.nl
+    assert len(said_kept) >= 10 and said_as_clause
+
+
+def test_what_holds_until_is_said_before_until(train_records):
+    """Tests that ``a U b`` over a proposition said in words reads "hold the box until
+    ...", "the door is open until ...", never "keep hold the box until ...", "the door
+    is open holds until ..."; names may take either ("keep (prop_1) until ...")."""
+    until = [r for r in train_records if any(
+        isinstance(n, Until) and isinstance(n.lhs, Atom) for n in walk(r.formula))]
+    garbled = re.compile(r"^(both |either )?(keep|continue) (?!\()|\b(holds|must hold) until\b")
+    assert [r for r in until if r.form == "lifted" and garbled.search(r.nl.lower())]
+    assert not [r.nl for r in until if r.form == "grounded" and re.search(
+        r"\b(holds|must hold) until\b|\b(keep|continue) (hold|keep|leave|go|pick|carry|wait|"
+        r"stay|be|the \w+ (is|are))\b", r.nl.lower())]
 
 
 def test_an_invariant_may_forbid_any_action(train_records):
