@@ -201,6 +201,9 @@ def _pattern_builders(rng: random.Random, iv: Interval | None, deadline: Interva
         # holds unless a condition does ("keep the vacuum docked unless the house is
         # empty"), which the fourth hand-written suite asked for and no version said
         lambda: Always(Eventually(a, deadline)), lambda: Always(Implies(Not(a), b)),
+        # 3.9: from a moment on for good ("once service is over, keep the fans off from
+        # then on"), which the suites write as G(a -> G(b)) and no pattern drew
+        lambda: Always(Implies(a, Always(b))),
     ]
 
 

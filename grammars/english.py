@@ -9,6 +9,7 @@ Idioms come before composition: ``G(!a)`` reads "never a", ``G(F(a))`` "a infini
 often", ``G(a -> F(b))`` "whenever a, eventually b", ``G(F[0,n](a))`` "a at least once
 every n steps", ``F[0,n](G(a))`` "within n steps, a for good", ``G(!a -> b)`` "b
 unless a", ``F(a & F(b))`` "first a, then b",
+``G(a -> G(b))`` "once a, b from then on",
 ``F(a & F[0,n](b))`` "a, and within n steps after that, b", ``!a U b`` "do not a until
 b", ``F(a & G(b))`` "eventually a, and from then on always b", ``(a | b) & !(a & b)`` "a
 or b, but not both"; in sampled sentences also ``F(a) & F(b)`` "a and b, in any order",
@@ -139,15 +140,19 @@ PHRASES: dict[str, tuple[str, ...]] = {
             "{a} or {b}, but not the two together"),
     "response": ("whenever {a}, eventually {b}", "every time {a}, {b} at some later point",
                  "each time {a}, make sure that eventually {b}", "if ever {a}, then eventually {b}",
-                 "{a} is always followed by {b}", "any time {a}, sooner or later {b}"),
+                 "{a} is always followed by {b}", "any time {a}, sooner or later {b}",
+                 "if {a}, eventually {b}", "when {a}, {b} at some point after that"),
     # Response with a command said on its own: "whenever the battery is low, go to the
     # charging station" asks for it some time after, as a bare command at the top does.
     "response_do": ("whenever {a}, {b}", "every time {a}, {b}", "each time {a}, {b} afterwards",
-                    "if ever {a}, {b} at some point after that", "{b} every time {a}"),
+                    "if ever {a}, {b} at some point after that", "{b} every time {a}",
+                    "if {a}, {b}", "when {a}, {b}"),
     "response_n": ("whenever {a}, {b} within {n} {u}",
                    "every time {a}, {b} within the next {n} {u}",
                    "each time {a}, {b} in at most {n} {u}",
-                   "whenever {a}, within {n} {u} {b}"),
+                   "whenever {a}, within {n} {u} {b}",
+                   "if {a}, {b} within {n} {u}", "when {a}, {b} within {n} {u}",
+                   "if {a}, {b} no more than {n} {u} later"),
     # G(a -> !b) with b an action: what is forbidden while a holds.
     "invariant_not": ("never {b} while {a}", "do not {b} while {a}", "never {b} when {a}",
                       "you must not {b} while {a}", "{b} is not allowed while {a}",
@@ -159,7 +164,14 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "invariant": ("whenever {a}, {b}", "every time {a}, also {b}", "{b} whenever {a}",
                   "at all times, if {a} then {b}", "always, if {a}, then {b}",
                   "while {a}, {b}", "{b} while {a}", "as long as {a}, {b}",
-                  "{b} as long as {a}", "{a} only when {b}", "{a} only while {b}"),
+                  "{b} as long as {a}", "{a} only when {b}", "{a} only while {b}",
+                  "if {a}, {b}", "when {a}, {b}"),
+    # G(a -> G(b)): from the moment a holds, b for good.
+    "once_always": ("once {a}, {b} from then on", "after {a}, {b} forever",
+                    "once {a}, always {b} after that", "if ever {a}, {b} from then on",
+                    "from the moment {a}, {b} for good"),
+    "once_never": ("once {a}, never {b} again", "after {a}, never {b} again",
+                   "once {a}, do not {b} ever again", "if ever {a}, never {b} after that"),
     "sequence": ("first {a}, then {b}", "{a} and after that {b}", "{a}, and afterwards {b}",
                  "{a} and then {b}", "eventually {a} and later {b}", "{a}, followed by {b}",
                  "{a}, then {b}", "{a} first, and {b} afterwards", "after {a}, {b}",
@@ -191,6 +203,11 @@ PHRASES: dict[str, tuple[str, ...]] = {
              "{a} until, between {lo} and {hi} {u} from now, {b}"),
     "->": ("if {a}, then {b}", "{a} implies {b}", "{b} if {a}", "in case {a}, {b}",
            "provided that {a}, {b}", "{a} means that {b}", "{a} only if {b}"),
+    # A top-level a -> b over a condition a at the first instant, in words: "if the door
+    # is open, ..." reads as a standing rule (G), as people write them.
+    "->now": ("if {a} at the start, then {b}", "if initially {a}, then {b}",
+              "{a} at the start implies {b}", "if right now {a}, then {b}",
+              "in case {a} at the outset, {b}"),
     "<->": ("{a} if and only if {b}", "{a} exactly when {b}", "{a} is equivalent to {b}",
             "{a} precisely when {b}", "{a} when and only when {b}",
             "{a}, if and only if {b}"),
@@ -205,6 +222,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
             "{a} and {b} at the same time"),
     "|()": ("either {a} or {b}", "at least one of {a} or {b}", "{a} or {b}"),
     "->()": ("if {a} then {b}",),
+    "->now()": ("if initially {a} then {b}", "if right now {a} then {b}"),
     "<->()": ("{a} exactly when {b}", "{a} if and only if {b}"),
     "U()": ("{a} until {b}",),
     "true": ("true",),
@@ -233,6 +251,9 @@ HELD_OUT: dict[str, frozenset[str]] = {
     "response_n": frozenset({"whenever {a}, within {n} {u} {b}"}),
     "invariant": frozenset({"always, if {a}, then {b}"}),
     "invariant_not": frozenset({"{b} is not allowed while {a}"}),
+    "once_always": frozenset({"from the moment {a}, {b} for good"}),
+    "once_never": frozenset({"once {a}, do not {b} ever again"}),
+    "->now": frozenset({"in case {a} at the outset, {b}"}),
     "sequence": frozenset({"{a}, followed by {b}"}),
     "sequence_n": frozenset({"{a}, and no more than {n} {u} later, {b}"}),
     "sequence3": frozenset({"in this order: {a}, {b}, {c}"}),
@@ -253,6 +274,13 @@ UNITS: tuple[tuple[str, str | None], ...] = (
     ("minutes", "minute"), ("hours", "hour"),
 )
 MODES = ("all", "train", "test")
+#: Said only of propositions in words: an "if"/"when" at the head of a standing rule is
+#: how people write G(a -> ...), while NL2TL's lifted sentences (the paper split's) read
+#: "if (prop_1), (prop_2)" at the first instant.
+IN_WORDS_ONLY = frozenset({
+    "if {a}, eventually {b}", "when {a}, {b} at some point after that", "if {a}, {b}",
+    "when {a}, {b}", "if {a}, {b} within {n} {u}", "when {a}, {b} within {n} {u}",
+    "if {a}, {b} no more than {n} {u} later"})
 #: Plain bracketing forms, said only when every operand is a proposition or its negation.
 PLAIN = frozenset({"{a} and {b}", "{a} or {b}", "{a} and {b} at the same time"})
 #: Commands said bare, as one side of a choice.
@@ -309,7 +337,7 @@ class Realizer:
         it, the first phrasing that ``allow`` admits."""
         plural, singular = UNITS[self.unit]
         options = [p for p in PHRASES[construct] if (singular is not None or "{s}" not in p)
-                   and (allow is None or allow(p))]
+                   and (allow is None or allow(p)) and (self.in_words or p not in IN_WORDS_ONLY)]
         held = HELD_OUT.get(construct, frozenset())
         if self.mode == "train":
             options = [p for p in options if p not in held] or options
@@ -412,6 +440,8 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
                           b=sub(f.rhs))
         return _timed("U", f.interval, r, used, allow=allow, a=sub(f.lhs), b=sub(f.rhs))
     op = "->" if isinstance(f, Implies) else "<->"
+    if op == "->" and r.in_words and now and _timeless(f.lhs):
+        op = "->now"  # "if the door is open, ..." would read as a standing rule
     if embedded:
         return r.pick(op + "()", used, a=sub_now(f.lhs), b=sub_now(f.rhs))
     scoped, only = _scoped(f.lhs, f.rhs), _only(f.lhs)
@@ -534,6 +564,13 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
     if _is_xor(f):
         one, other = f.args[0].args
         return r.pick("xor", used, a=_choice(one, r, used, now), b=_choice(other, r, used, now))
+    if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies) \
+            and _untimed(f.arg.rhs, Always) is not None:
+        # "once the alarm sounds, keep the door closed from then on"
+        lhs, kept = f.arg.lhs, f.arg.rhs.arg
+        if isinstance(kept, Not) and isinstance(kept.arg, Atom) and r.is_action(kept.arg.name):
+            return r.pick("once_never", used, a=sub(lhs), b=sub(kept.arg))
+        return r.pick("once_always", used, a=sub(lhs), b=sub(kept))
     if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies):
         lhs, rhs = f.arg.lhs, f.arg.rhs
         if isinstance(rhs, Eventually) and (rhs.interval is None or (

@@ -37,6 +37,7 @@ from ara.grammars.ast import (
     Iff,
     Implies,
     Not,
+    Or,
     Until,
     atoms_read_now,
     depth,
@@ -230,6 +231,37 @@ def test_what_holds_until_is_said_before_until(train_records):
     assert not [r.nl for r in until if r.form == "grounded" and re.search(
         r"\b(holds|must hold) until\b|\b(keep|continue) (hold|keep|leave|go|pick|carry|wait|"
         r"stay|be|the \w+ (is|are))\b", r.nl.lower())]
+
+
+def test_a_rule_said_with_if_or_when_holds_at_all_times(train_records):
+    """Tests the grounded convention people write ("If frost is detected, cover the
+    seedlings within 5 minutes" is G(frost -> F[0,5](cover))): an implication at the
+    first instant over a condition says so ("if initially ..."), and "if"/"when" heads
+    standing rules. Lifted sentences keep NL2TL's reading ("if (prop_1), (prop_2)" at
+    the first instant), as the paper split has it."""
+    first_instant = re.compile(r"\b(at the start|initially|right now|at the outset)\b")
+    grounded = [r for r in train_records if r.form == "grounded"]
+    now_rules = [r for r in grounded if any(
+        isinstance(g, Implies) and atoms_read_now(g.lhs) and not any(
+            isinstance(n, (Always, Eventually, Until)) for n in walk(g.lhs))
+        for g in _first_instant(r.formula))]
+    assert now_rules and all(first_instant.search(r.nl) for r in now_rules), [
+        r.nl for r in now_rules if not first_instant.search(r.nl)][:3]
+    standing = [r for r in grounded if isinstance(r.formula, Always)
+                and re.match(r"(if|when) (?!ever\b)", r.nl.lower())]
+    assert len(standing) >= 20, [r.nl for r in standing]
+    once = [r for r in grounded if isinstance(r.formula, Always)
+            and isinstance(r.formula.arg, Implies) and isinstance(r.formula.arg.rhs, Always)]
+    assert once and [r for r in once if re.search(r"\b(once|from then on|again)\b", r.nl)]
+
+
+def _first_instant(f):
+    """The subformulas read at the first instant: ``f`` and, down ``&`` and ``|``,
+    their operands."""
+    yield f
+    if isinstance(f, (And, Or)):
+        for g in f.args:
+            yield from _first_instant(g)
 
 
 def test_an_invariant_may_forbid_any_action(train_records):
