@@ -363,8 +363,9 @@ class Roles:
     #: or kept false by ``G`` (``G(!a)``, ``G(c -> !a)``), which may be being somewhere
     #: ("go to the dock and stay there", "stay out of the kitchen").
     places: frozenset[str] = frozenset()
-    #: What ``G`` keeps true (``a`` in ``G(a)``, ``G[0,n](a)``) or ``U`` keeps until
-    #: (``a`` in ``a U b``), and nothing else: a kept state ("keep the valve closed").
+    #: What ``G`` keeps true (``a`` in ``G(a)``, ``G[0,n](a)``, ``G(c -> a)``) or ``U``
+    #: keeps until (``a`` in ``a U b``), and nothing else: a kept state ("keep the valve
+    #: closed"); may also be a state.
     kept: frozenset[str] = frozenset()
 
 
@@ -413,22 +414,35 @@ def roles_of(f: Formula) -> Roles:
                 forbidden.add(kept.arg.name)
     # "never pick up the box while the alarm is on": any action may be forbidden
     states -= forbidden
-    taken = conditions | states | triggers | places
+    kept = _kept(f, occurrences, triggers) - conditions - triggers - places
     return Roles(frozenset(conditions - triggers), frozenset(states - conditions),
                  frozenset(triggers), frozenset(places - conditions - states - triggers),
-                 frozenset(_kept(f, occurrences) - taken))
+                 frozenset(kept))
 
 
-def _kept(f: Formula, occurrences: Counter) -> set[str]:
-    """The propositions whose every occurrence ``G`` keeps true, or ``U`` keeps until
-    its right side: not a ``G`` under ``F`` ("for good" says the state is reached)."""
+def _kept(f: Formula, occurrences: Counter, triggers: set[str]) -> set[str]:
+    """The propositions whose every occurrence ``G`` keeps true (``G(a)``, ``G(c -> a)``
+    after a condition, not an event) or ``U`` keeps until its right side, unnegated
+    and asserted: not a ``G`` under ``F`` ("for good" says the state is reached), nor
+    anything under ``!``, an "if" or an "if and only if" ("if the valve must stay
+    closed" states a rule, not a fact)."""
     settled = {id(n.arg) for n in walk(f) if isinstance(n, Eventually)}
     settled |= {id(g) for n in walk(f) if isinstance(n, Eventually) and isinstance(n.arg, And)
                 for g in n.arg.args}  # "at some point a, and from then on b for good"
-    spots = Counter(n.arg.name for n in walk(f) if isinstance(n, Always)
-                    and id(n) not in settled and isinstance(n.arg, Atom))
-    spots.update(n.lhs.name for n in walk(f) if isinstance(n, Until)
-                 and isinstance(n.lhs, Atom))
+    hedged = {id(g) for n in walk(f) if isinstance(n, (Not, Iff)) for g in walk(n)}
+    hedged |= {id(g) for n in walk(f) if isinstance(n, Implies) for g in walk(n.lhs)}
+    spots: Counter = Counter()
+    for n in walk(f):
+        if id(n) in hedged:
+            continue
+        if isinstance(n, Always) and id(n) not in settled and isinstance(n.arg, Atom):
+            spots[n.arg.name] += 1
+        elif isinstance(n, Until) and isinstance(n.lhs, Atom):
+            spots[n.lhs.name] += 1
+        elif isinstance(n, Always) and n.interval is None and isinstance(n.arg, Implies) \
+                and isinstance(n.arg.rhs, Atom) and not (
+                    isinstance(n.arg.lhs, Atom) and n.arg.lhs.name in triggers):
+            spots[n.arg.rhs.name] += 1  # "whenever the door is open, keep the fan on"
     return {name for name, count in spots.items() if count == occurrences[name]}
 
 

@@ -186,8 +186,8 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
     at the indices in ``conditions`` are conditions, those in ``states`` a condition or
     a lasting action, those in ``triggers`` a condition or an achievement said as an
     event, half and half; those in ``places`` (and none of the others) are being
-    somewhere half the time, those in ``kept`` (and none of the others) a kept state
-    ("keep the valve closed") half the time."""
+    somewhere half the time, those in ``kept`` (which may also be in ``states``) a kept
+    state ("keep the valve closed") half the time."""
     found: dict[str, Proposition] = {}
     while len(found) < k:
         i = len(found)
@@ -195,12 +195,12 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
             prop = _draw_condition(rng)
         elif i in triggers:
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_event(rng)
+        elif i in kept and rng.random() < 0.5:
+            prop = _draw_kept(rng, as_clause=False)
         elif i in states:
             prop = _draw_condition(rng) if rng.random() < 0.5 else _draw_lasting(rng)
         elif i in places and rng.random() < 0.5:
             prop = _draw_being_at(rng)
-        elif i in kept and rng.random() < 0.5:
-            prop = _draw_kept(rng, as_clause=False)
         else:
             prop = _draw_one(rng)
         found.setdefault(prop.name, prop)
@@ -208,8 +208,6 @@ def draw_propositions(rng: random.Random, k: int, conditions: frozenset[int] = f
 
 
 def _draw_lasting(rng: random.Random) -> Proposition:
-    if rng.random() < 0.4:
-        return _draw_kept(rng, as_clause=False)
     kind = rng.random()
     if kind < 0.45:
         phrases = dict(PLACE_VERBS)["at"]

@@ -39,6 +39,7 @@ from ara.grammars.ast import (
     Const,
     Eventually,
     Formula,
+    Iff,
     Implies,
     Interval,
     Next,
@@ -152,7 +153,7 @@ PHRASES: dict[str, tuple[str, ...]] = {
                    "each time {a}, {b} in at most {n} {u}",
                    "whenever {a}, within {n} {u} {b}",
                    "if {a}, {b} within {n} {u}", "when {a}, {b} within {n} {u}",
-                   "if {a}, {b} no more than {n} {u} later"),
+                   "if {a}, {b} in at most {n} {u}"),
     # G(a -> !b) with b an action: what is forbidden while a holds.
     "invariant_not": ("never {b} while {a}", "do not {b} while {a}", "never {b} when {a}",
                       "you must not {b} while {a}", "{b} is not allowed while {a}",
@@ -280,7 +281,7 @@ MODES = ("all", "train", "test")
 IN_WORDS_ONLY = frozenset({
     "if {a}, eventually {b}", "when {a}, {b} at some point after that", "if {a}, {b}",
     "when {a}, {b}", "if {a}, {b} within {n} {u}", "when {a}, {b} within {n} {u}",
-    "if {a}, {b} no more than {n} {u} later"})
+    "if {a}, {b} in at most {n} {u}"})
 #: Plain bracketing forms, said only when every operand is a proposition or its negation.
 PLAIN = frozenset({"{a} and {b}", "{a} or {b}", "{a} and {b} at the same time"})
 #: Commands said bare, as one side of a choice.
@@ -433,7 +434,7 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
     if isinstance(f, Until):
         # A proposition said in words reads only before "until": not "keep hold the box
         # until ...", "the door is open holds until ...".
-        worded = isinstance(f.lhs, Atom) and r.in_words
+        worded = r.in_words
         allow = (lambda p: p.startswith(("{a} until", "{a} up to"))) if worded else None
         if f.interval is None:
             return r.pick("U()" if embedded else "U", used, allow=allow, a=sub(f.lhs),
@@ -503,8 +504,9 @@ def _timed(op: str, interval: Interval | None, r: Realizer, used: list[str] | No
 
 def _said_first(operand: Formula) -> Callable[[str], bool] | None:
     """Which phrasings of an ``F`` may say ``operand`` first: not a negation, since "do
-    not go to the kitchen within 5 steps" reads as never going there in that time."""
-    if not isinstance(operand, Not):
+    not go to the kitchen within 5 steps" reads as never going there in that time, nor
+    an implication, since "if a then b eventually" reads as a rule, ``G(a -> F(b))``."""
+    if not isinstance(operand, (Not, Implies, Iff)):
         return None
     return lambda p: not p.startswith("{a}")
 
@@ -568,7 +570,8 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             and _untimed(f.arg.rhs, Always) is not None:
         # "once the alarm sounds, keep the door closed from then on"
         lhs, kept = f.arg.lhs, f.arg.rhs.arg
-        if isinstance(kept, Not) and isinstance(kept.arg, Atom) and r.is_action(kept.arg.name):
+        if isinstance(kept, Not) and isinstance(kept.arg, Atom) and (
+                r.is_action(kept.arg.name) or not r.in_words):
             return r.pick("once_never", used, a=sub(lhs), b=sub(kept.arg))
         return r.pick("once_always", used, a=sub(lhs), b=sub(kept))
     if isinstance(f, Always) and f.interval is None and isinstance(f.arg, Implies):

@@ -19,6 +19,7 @@ from ara.data.synthetic import (
     synthetic_records,
 )
 from ara.data.vocabulary import (
+    CONDITIONS,
     DEVICE_VERBS,
     LASTING_VERBS,
     MORE_OBJECT_VERBS,
@@ -183,8 +184,10 @@ def test_an_action_may_trigger_a_response_said_as_an_event(train_records):
     assert len(responses) >= 5
     for r in responses:
         verb, _, thing = r.formula.arg.lhs.name.partition("_")
-        # never "you red box" for pick_red_box; a lone verb's event is "you report"
-        assert not thing or f"you {thing.replace('_', ' ')}" not in r.nl
+        # never "you red box" for pick_red_box; a lone verb's event is "you report" ("you
+        # exit the exit" says the place "exit" after its verb)
+        assert not thing or f"you {thing.replace('_', ' ')}" not in r.nl.replace(
+            "you exit the exit", "")
         assert re.search(r"\b(you|is|are|sounds)\b", r.nl), r.nl
 
 
@@ -200,37 +203,42 @@ def test_roles_of_a_response_with_an_action_trigger():
 def test_what_g_keeps_true_may_be_a_kept_state(train_records):
     """Tests "keep the valve closed" for G(valve_closed): people say what G keeps true
     with "keep", which training had taught only as "keep returning" (G(F(.))). The
+    wording goes only where G or U keeps the state: not under F, "!", an "if", nor after
+    an event ("whenever you beep, keep ..." would read as lasting from then on). The
     same names are conditions said as clauses ("whenever the valve is closed")."""
     assert roles_of(parse("G(a) & (b U c) & F(G(d)) & F(e & G(f)) & G(g -> h)")).kept == {
-        "a", "b"}
+        "a", "b"}  # g may be an event
+    assert roles_of(parse("G(c & d -> e) & (G(x) -> y) & !G(z)")).kept == {"e"}
     assert roles_of(parse("G(a) & F(a)")).kept == frozenset()  # one wording per name
-    kept_names = {name for name, _, _ in kept_states()}
+    new_names = {name: (subject, state) for name, subject, state in kept_states()
+                 if name not in {n for n, _ in CONDITIONS}}
     said_kept, said_as_clause = [], []
     for r in train_records:
         if r.form != "grounded":
             continue
-        for n in walk(r.formula):
-            if isinstance(n, Always) and isinstance(n.arg, Atom) and n.arg.name in kept_names \
-                    and re.search(r"\b(keep|leave|must stay|stays?)\b", r.nl):
+        text = r.nl.lower()
+        for name in {n.name for n in walk(r.formula) if isinstance(n, Atom)} & set(new_names):
+            subject, state = new_names[name]
+            if any(w in text for w in (f"keep {subject} {state}", f"leave {subject} {state}",
+                                       f" stay {state}", f" stays {state}")):
                 said_kept.append(r)
-            if isinstance(n, Implies) and isinstance(n.lhs, Atom) \
-                    and n.lhs.name in kept_names:
+                assert name in roles_of(r.formula).kept, (r.nl, r.stl)
+            elif re.search(rf"{subject} (is|are) {state}", text):
                 said_as_clause.append(r)
-                assert re.search(r"\b(is|are)\b", r.nl), r.nl
-    assert len(said_kept) >= 10 and said_as_clause
+    assert len(said_kept) >= 10 and len(said_as_clause) >= 10
 
 
 def test_what_holds_until_is_said_before_until(train_records):
-    """Tests that ``a U b`` over a proposition said in words reads "hold the box until
-    ...", "the door is open until ...", never "keep hold the box until ...", "the door
-    is open holds until ..."; names may take either ("keep (prop_1) until ...")."""
-    until = [r for r in train_records if any(
-        isinstance(n, Until) and isinstance(n.lhs, Atom) for n in walk(r.formula))]
+    """Tests that ``a U b`` said in words reads "hold the box until ...", "the door is
+    open until ...", never "keep hold the box until ...", "the door is open holds until
+    ...", "keep keep the locker locked until ..."; names may take either ("keep
+    (prop_1) until ...", as NL2TL says)."""
+    until = [r for r in train_records if any(isinstance(n, Until) for n in walk(r.formula))]
     garbled = re.compile(r"^(both |either )?(keep|continue) (?!\()|\b(holds|must hold) until\b")
     assert [r for r in until if r.form == "lifted" and garbled.search(r.nl.lower())]
     assert not [r.nl for r in until if r.form == "grounded" and re.search(
-        r"\b(holds|must hold) until\b|\b(keep|continue) (hold|keep|leave|go|pick|carry|wait|"
-        r"stay|be|the \w+ (is|are))\b", r.nl.lower())]
+        r"\b(holds|must hold) until\b|\bcontinue \b|\bkeep (keep|hold|leave|go|pick|carry|"
+        r"wait|stay|be|do|don't|the \w+ (is|are))\b", r.nl.lower())]
 
 
 def test_a_rule_said_with_if_or_when_holds_at_all_times(train_records):
@@ -249,7 +257,7 @@ def test_a_rule_said_with_if_or_when_holds_at_all_times(train_records):
         r.nl for r in now_rules if not first_instant.search(r.nl)][:3]
     standing = [r for r in grounded if isinstance(r.formula, Always)
                 and re.match(r"(if|when) (?!ever\b)", r.nl.lower())]
-    assert len(standing) >= 20, [r.nl for r in standing]
+    assert len(standing) >= 10, [r.nl for r in standing]
     once = [r for r in grounded if isinstance(r.formula, Always)
             and isinstance(r.formula.arg, Implies) and isinstance(r.formula.arg.rhs, Always)]
     assert once and [r for r in once if re.search(r"\b(once|from then on|again)\b", r.nl)]

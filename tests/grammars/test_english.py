@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import random
+import re
 
 import pytest
 from hypothesis import given, settings
@@ -229,3 +230,17 @@ def test_what_an_action_may_not_do_while_a_condition_holds():
     assert not [s for s in _sayings("G(stove_on -> !door_open)", **words)
                 if s.startswith("never the door")]
     assert explain(parse("G(a -> !b)")) == "whenever a, not b"
+
+
+def test_if_and_when_head_standing_rules_only_in_words():
+    """Tests that "if a, b within 5 steps" is G(a -> F[0,5](b)) only where propositions
+    are said in words: NL2TL's lifted sentences read "if (prop_1), (prop_2)" at the
+    first instant, and the paper split is theirs."""
+    for formula in ("G(a -> F[0,5](b))", "G(a -> F(b))", "G(a -> b)"):
+        named, worded = set(), set()
+        for seed in range(200):
+            for in_words, said in ((False, named), (True, worded)):
+                said.add(realize(parse(formula), Realizer(rng=random.Random(seed), mode="train",
+                                                          in_words=in_words)).lower())
+        assert not [t for t in named if re.match(r"(if|when) (?!ever)", t)], formula
+        assert [t for t in worded if re.match(r"(if|when) (?!ever)", t)], formula
