@@ -49,11 +49,22 @@ def train_cmd(
     stages after it. OUT/recipe.json records each stage's wall time and peak memory.
     """
     import json
+    import signal
 
     from ara.training.recipe import main
 
-    with user_errors():
-        summary = main(str(config), max_steps, resume)
+    # A scheduler or `timeout` stops a run with SIGTERM, and a shell's background job
+    # ignores Ctrl-C's SIGINT: both now stop it as Ctrl-C does in a terminal, so a recipe
+    # records the time the stage took and the log ends on a whole line.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with user_errors():
+            summary = main(str(config), max_steps, resume)
+    except KeyboardInterrupt:
+        typer.echo("interrupted: rerun the same command (a single run with --resume) to go "
+                   "on from the newest checkpoint", err=True)
+        raise typer.Exit(130) from None
     typer.echo(json.dumps(summary, indent=2))
 
 

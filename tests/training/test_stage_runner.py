@@ -10,6 +10,7 @@ import yaml
 
 from ara.data import registered_version
 from ara.errors import ConfigError
+from ara.training.run_folder import whole_checkpoints
 from ara.training.stages import StagedRecipe, run_recipe
 
 SHIPPED_RECIPE = Path(__file__).parents[2] / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
@@ -223,3 +224,40 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     assert (kept / "adapter" / "adapter_model.safetensors").is_file()
     assert "stage refine-b: started (train)" in lines and "stage soup: started (soup)" in lines
     assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
+
+
+@pytest.mark.slow  # a recipe in a subprocess, stopped as a scheduler stops it
+def test_a_recipe_stopped_with_sigterm_records_its_time_and_goes_on(tiny_gemma_dir, tmp_path):
+    """Tests `ara train --config RECIPE` stopped by SIGTERM (a scheduler, `timeout`, or
+    a background job, which ignores Ctrl-C): it ends as Ctrl-C does, exit 130 with
+    what to do, the stage's time recorded and its log whole; a rerun goes on."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "recipe"
+    recipe = tiny_recipe(tiny_gemma_dir, out)
+    recipe["stages"][0]["train"] = {"max_steps": 400, "optim": {"epochs": 200}}
+    config = tmp_path / "recipe.yaml"
+    config.write_text(yaml.safe_dump(recipe))
+    ara = [sys.executable, "-m", "ara.cli", "train", "--config", str(config)]
+    # A file, not a pipe: the progress bar would fill a pipe nobody reads yet
+    errors = tmp_path / "stderr.txt"
+    with open(errors, "w") as sink:
+        proc = subprocess.Popen(ara, stdout=subprocess.DEVNULL, stderr=sink)
+    log = out / "start" / "train_log.jsonl"
+    deadline = time.monotonic() + 300
+    while proc.poll() is None and time.monotonic() < deadline and not (
+            log.is_file() and log.read_text().count("\n") >= 3):
+        time.sleep(0.1)
+    assert proc.poll() is None, errors.read_text()  # still training
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=120)
+    stderr = errors.read_text()
+    assert proc.returncode == 130 and "interrupted: rerun the same command" in stderr, stderr
+    state = json.loads((out / "start" / "stage.json").read_text())
+    assert state["done"] is False and state["sessions"] == 1 and state["wall_s"] > 0
+    lines = log.read_text().splitlines()
+    assert all(json.loads(line)["step"] for line in lines)  # every line whole
+    assert whole_checkpoints(out / "start")  # checkpoint_every 1: it goes on from there
