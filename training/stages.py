@@ -289,6 +289,28 @@ def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
     return dest
 
 
+def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | None:
+    """Bring back the newest folder of stage ``name`` set aside with this very
+    fingerprint (an edit undone, a data version pinned again), done or resumable,
+    setting aside what stands in its place; returns its stage record, else ``None``."""
+    folder = recipe.folder(name)
+    if (_state(folder) or {}).get("fingerprint") == fingerprint:
+        return None
+    for old in sorted((recipe.out / REPLACED).glob(f"{name}-*"), reverse=True):
+        state = _state(old)
+        if state and state.get("name") == name and state.get("fingerprint") == fingerprint \
+                and (state.get("done") or whole_checkpoints(old)):
+            if folder.exists():
+                if _has_training(folder):
+                    _set_aside(recipe, folder)
+                else:
+                    shutil.rmtree(folder)
+            shutil.move(str(old), str(folder))
+            log(f"stage {name}: brought back from {old} (made with these settings)")
+            return state
+    return None
+
+
 def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
                max_steps: int | None) -> dict:
     folder = recipe.folder(stage.name)
@@ -345,6 +367,11 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
     record.setdefault("stages", {})
     ran: set[str] = set()
     for stage in recipe.stages:
+        if stage.kind == "train" and not ran.intersection(stage.inputs):
+            restored = _restore(recipe, stage.name, prints[stage.name], log)
+            if restored is not None and restored.get("done"):
+                record["stages"][stage.name] = {k: v for k, v in restored.items()
+                                                if k != "done"}
         folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
         same = bool(state and state.get("fingerprint") == prints[stage.name]
                     and not ran.intersection(stage.inputs))

@@ -225,6 +225,15 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     assert "stage refine-b: started (train)" in lines and "stage soup: started (soup)" in lines
     assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
 
+    # Undoing the edit brings the set-aside stage back instead of training it again.
+    lines.clear()
+    run_recipe(StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out)), log=lines.append)
+    assert f"stage refine-b: brought back from {kept} (made with these settings)" in lines
+    assert "stage refine-b: done, skipped" in lines
+    assert not [line for line in lines if line.startswith("stage refine-b: started")]
+    assert "stage soup: started (soup)" in lines  # it was the edited one's soup
+    assert json.loads((out / "refine-b" / "run.json").read_text())["config"]["seed"] == 2
+
 
 @pytest.mark.slow  # a recipe in a subprocess, stopped as a scheduler stops it
 def test_a_recipe_stopped_with_sigterm_records_its_time_and_goes_on(tiny_gemma_dir, tmp_path):
