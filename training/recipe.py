@@ -89,17 +89,18 @@ class LoRAFinetuneRecipe:
         # The first use of a registered split prepares it; one process writes it.
         with self.accelerator.main_process_first():
             self.train_records, self.split = self._load_data()
-        per_epoch = -(-len(self.train_records) // self.config.optim.batch_size)
-        total = per_epoch * self.config.optim.epochs // self.config.optim.grad_accum
+        optim = self.config.optim
+        # Micro-batches: an optimizer step takes grad_accum of them, across an epoch's
+        # end where they do not divide it.
+        self.batches_per_epoch = -(-len(self.train_records) // optim.batch_size)
+        total = self.batches_per_epoch * optim.epochs // optim.grad_accum
         self.total_steps = min(total, self.config.max_steps or total)
-        self.steps_per_epoch = per_epoch // self.config.optim.grad_accum
-        if not self.steps_per_epoch or not self.total_steps:
-            optim = self.config.optim
+        if not self.total_steps:
             raise ConfigError(
-                f"{len(self.train_records)} training records make {per_epoch} batches of "
-                f"{optim.batch_size}, fewer than one optimizer step of grad_accum "
-                f"{optim.grad_accum}: train on more records (data.forms, data.limit) or "
-                "lower batch_size or grad_accum")
+                f"{len(self.train_records)} training records make {self.batches_per_epoch} "
+                f"batches of {optim.batch_size} an epoch: {optim.epochs} epochs of them are "
+                f"fewer than one optimizer step of grad_accum {optim.grad_accum}; train on more "
+                "records (data.forms, data.limit) or epochs, or lower batch_size or grad_accum")
         model = self._lora_model()
         optimizer = torch.optim.AdamW([p for p in model.parameters() if p.requires_grad],
                                       lr=self.config.optim.lr,
@@ -202,12 +203,14 @@ class LoRAFinetuneRecipe:
         micro_losses: list[float] = []
         micro_shots: list[int] = []
         tokens, start = 0, time.perf_counter()
+        # Where the micro-batches stand: a resumed run starts at a step's first one.
+        taken = self.step * cfg.optim.grad_accum
         try:
             while self.step < self.total_steps:
-                epoch, done = divmod(self.step, self.steps_per_epoch)
-                skip = done * cfg.optim.grad_accum
+                epoch, skip = divmod(taken, self.batches_per_epoch)
                 for index, micro in enumerate(batches(self.train_records, cfg.optim.batch_size,
                                                       cfg.seed, epoch, skip), start=skip):
+                    taken += 1
                     if not micro_losses:
                         start = time.perf_counter()
                     shots = self._shots(micro, epoch, index)

@@ -1,6 +1,7 @@
 """The LoRA recipe on a tiny Gemma 3 built from a config: loss falls, resume, held-out check."""
 
 import json
+import shutil
 
 import pytest
 
@@ -88,9 +89,37 @@ def test_a_run_killed_before_its_first_checkpoint_resumes_from_step_0(tiny_gemma
 def test_too_few_records_for_one_optimizer_step_are_refused(tiny_gemma_dir, tmp_path):
     config = tiny_config(tiny_gemma_dir, tmp_path / "run",
                          optim={"lr": 5e-3, "batch_size": 8, "grad_accum": 2})
-    with pytest.raises(ConfigError, match="8 training records make 1 batches of 8, fewer "
-                                          "than one optimizer step of grad_accum 2"):
+    with pytest.raises(ConfigError, match="8 training records make 1 batches of 8 an epoch: "
+                                          "1 epochs of them are fewer than one optimizer step "
+                                          "of grad_accum 2"):
         LoRAFinetuneRecipe(config).setup()
+
+
+def test_steps_that_span_an_epoch_end_resume_where_they_stood(tiny_gemma_dir, tmp_path):
+    """Tests grad_accum 2 over 3 batches an epoch, so steps 2 and 5 span an epoch's end:
+    every epoch is taken whole, once (the position comes from the micro-batches taken;
+    counting whole steps an epoch skipped the third), and a run resumed from step 3
+    takes the batches an uninterrupted one takes."""
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=None, checkpoint_every=3,
+                         keep_checkpoints=2,
+                         optim={"lr": 5e-3, "batch_size": 4, "grad_accum": 2, "epochs": 4,
+                                "warmup_steps": 0},
+                         data={"forms": ["lifted"], "limit": 12})
+    whole = LoRAFinetuneRecipe(config)
+    whole.setup()
+    assert len(whole.train()) == 6
+    whole.save_checkpoint()
+    log = tmp_path / "run" / "train_log.jsonl"
+    steps = [json.loads(x) for x in log.read_text().splitlines()]
+    # 12 batches in 4 epochs of 3, two a step: the epoch each step ends in, none skipped
+    assert [x["epoch"] for x in steps] == [0, 1, 1, 2, 3, 3]
+    uninterrupted = [x["loss"] for x in steps]
+    shutil.rmtree(tmp_path / "run" / "checkpoints" / "step_6")  # as if killed after step 5
+    log.write_text("".join(x + "\n" for x in log.read_text().splitlines()[:3]))
+    resumed = LoRAFinetuneRecipe(config, resume=True)
+    resumed.setup()
+    assert resumed.step == 3
+    assert resumed.train() == pytest.approx(uninterrupted[3:], rel=1e-4)
 
 
 @pytest.mark.slow  # the harness runs a real model by default (test_resume_after_kill)
