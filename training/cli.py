@@ -53,18 +53,24 @@ def train_cmd(
 
     from ara.training.recipe import main
 
-    # A scheduler or `timeout` stops a run with SIGTERM, and a shell's background job
-    # ignores Ctrl-C's SIGINT: both now stop it as Ctrl-C does in a terminal, so a recipe
-    # records the time the stage took and the log ends on a whole line.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    # A scheduler, `timeout` or `kill` stops a run with SIGTERM: it now ends as Ctrl-C
+    # does, so a recipe records the time the stage took and the log ends on a whole line.
+    terminated = []
+
+    def stop(signum, frame):
+        terminated.append(signum)
+        raise KeyboardInterrupt
+
+    before = signal.signal(signal.SIGTERM, stop)
     try:
         with user_errors():
             summary = main(str(config), max_steps, resume)
     except KeyboardInterrupt:
         typer.echo("interrupted: rerun the same command (a single run with --resume) to go "
                    "on from the newest checkpoint", err=True)
-        raise typer.Exit(130) from None
+        raise typer.Exit(143 if terminated else 130) from None
+    finally:
+        signal.signal(signal.SIGTERM, before)
     typer.echo(json.dumps(summary, indent=2))
 
 

@@ -39,6 +39,7 @@ from ara.training.dataset import (
 from ara.training.hf_model import load_tokenizer
 from ara.training.run_folder import (
     adapter_identity,
+    exclusive,
     log_summary,
     refuse_changed_config,
     refuse_changed_data,
@@ -298,6 +299,12 @@ class LoRAFinetuneRecipe:
 
     def _load_checkpoint(self) -> None:
         found = whole_checkpoints(self.out)
+        if not found and not self.out.joinpath("run.json").is_file():
+            raise ConfigError(f"--resume: {self.out} holds no run (no run.json): drop --resume "
+                              "to start one")
+        if not found and self.out.joinpath("adapter").is_dir():
+            raise ConfigError(f"--resume: {self.out} is a finished run (adapter/) with no "
+                              "checkpoint left to go on from: train into another out folder")
         if not found:
             # Killed before its first checkpoint: nothing to go on from, so it starts over
             # (its log's steps are taken again).
@@ -374,6 +381,11 @@ def _warm_started(base, folder: str, lora):
 
 def run_training(config: TrainConfig, resume: bool = False) -> dict:
     """Train, save the adapter, run the held-out check; returns a summary."""
+    with exclusive(Path(config.out)):
+        return _run_training(config, resume)
+
+
+def _run_training(config: TrainConfig, resume: bool) -> dict:
     recipe = LoRAFinetuneRecipe(config, resume)
     recipe.setup()
     recipe.train()

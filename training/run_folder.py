@@ -4,12 +4,35 @@ its log. The recipe writes the folder (``training/recipe.py``)."""
 
 from __future__ import annotations
 
+import fcntl
 import json
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from ara.errors import ConfigError
 from ara.provenance import differing
 from ara.training.config import BOOKKEEPING, TrainConfig
+
+
+@contextmanager
+def exclusive(out: Path) -> Iterator[None]:
+    """Hold ``out`` for one ``ara train`` at a time: a second one on the same folder (a
+    rerun started while the first still trains) would write the same checkpoints, or
+    set the live folder aside. Only the first process of a multi-process run holds it."""
+    if int(os.environ.get("RANK", "0")) != 0:
+        yield
+        return
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / ".lock", "w") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ConfigError(f"another ara train is running on {out}: wait for it, or stop "
+                              "it first") from None
+        yield
 
 
 def whole_checkpoints(out: Path) -> list[Path]:

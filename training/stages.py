@@ -38,7 +38,7 @@ from typing import Any
 
 from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
 from ara.training.config import BOOKKEEPING, TrainConfig
-from ara.training.run_folder import adapter_identity, whole_checkpoints
+from ara.training.run_folder import adapter_identity, exclusive, whole_checkpoints
 from ara.training.soup import check_soup
 
 KINDS = ("train", "soup", "export")
@@ -227,13 +227,21 @@ def is_staged(data: dict) -> bool:
 # -- running ----------------------------------------------------------------------------
 
 def _state(folder: Path) -> dict | None:
+    """A stage folder's record; ``None`` where it has none (or one a crash left unread-
+    able: the stage is then rebuilt, its folder set aside)."""
     path = folder / "stage.json"
-    return json.loads(path.read_text()) if path.is_file() else None
+    try:
+        return json.loads(path.read_text()) if path.is_file() else None
+    except json.JSONDecodeError:
+        return None
 
 
 def _write_state(folder: Path, state: dict) -> None:
+    """Replace the record whole: a kill leaves the old one or the new one."""
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / "stage.json").write_text(json.dumps(state, indent=2, sort_keys=True) + "\n")
+    tmp = folder / "stage.json.tmp"
+    tmp.write_text(json.dumps(state, indent=2, sort_keys=True) + "\n")
+    tmp.replace(folder / "stage.json")
 
 
 def _peak_memory() -> dict:
@@ -289,6 +297,11 @@ def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
     return dest
 
 
+def _write_record(path: Path, record: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+
+
 def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | None:
     """Bring back the newest folder of stage ``name`` set aside with this very
     fingerprint (an edit undone, a data version pinned again), done or resumable,
@@ -300,13 +313,15 @@ def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | N
         state = _state(old)
         if state and state.get("name") == name and state.get("fingerprint") == fingerprint \
                 and (state.get("done") or whole_checkpoints(old)):
+            kept = None
             if folder.exists():
                 if _has_training(folder):
-                    _set_aside(recipe, folder)
+                    kept = _set_aside(recipe, folder)
                 else:
                     shutil.rmtree(folder)
             shutil.move(str(old), str(folder))
-            log(f"stage {name}: brought back from {old} (made with these settings)")
+            log(f"stage {name}: brought back from {old} (made with these settings)"
+                + (f"; the folder in its place is kept as {kept}" if kept else ""))
             return state
     return None
 
@@ -347,6 +362,7 @@ def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
 
 def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) -> dict:
     """Run the stages that are not done; returns the recipe's record (``recipe.json``).
+    One at a time on a recipe's folder (:func:`~ara.training.run_folder.exclusive`).
 
     Args:
         recipe: The stages.
@@ -359,6 +375,11 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
         raise ConfigError("a staged recipe runs in one process (its stage records, soups and "
                           "exports are written once): run it on one GPU "
                           "(scripts/train_gpu.sh does), or give several a single-run config")
+    with exclusive(recipe.out):
+        return _run_recipe(recipe, max_steps, log)
+
+
+def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
     prints = recipe.fingerprints()
     if max_steps is not None:
         prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}
@@ -372,6 +393,7 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
             if restored is not None and restored.get("done"):
                 record["stages"][stage.name] = {k: v for k, v in restored.items()
                                                 if k != "done"}
+                _write_record(record_path, record)
         folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
         same = bool(state and state.get("fingerprint") == prints[stage.name]
                     and not ran.intersection(stage.inputs))
@@ -419,7 +441,6 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
         _write_state(recipe.folder(stage.name), {**entry, "done": True})
         record["stages"][stage.name] = entry
         ran.add(stage.name)
-        record_path.parent.mkdir(parents=True, exist_ok=True)
-        record_path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+        _write_record(record_path, record)
         log(f"stage {stage.name}: done in {wall:.0f} s")
     return record

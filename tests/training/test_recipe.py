@@ -60,8 +60,10 @@ def test_a_few_steps_lower_the_loss_and_resume_continues(tiny_gemma_dir, tmp_pat
         LoRAFinetuneRecipe(config)
     # Pinning the version the run started on (unpinned) is no change.
     pinned = {**config.to_dict()["data"], "version": registered_version("paper", 0)}
-    LoRAFinetuneRecipe(TrainConfig.from_dict({**config.to_dict(), "data": pinned}),
-                       resume=True)
+    again = LoRAFinetuneRecipe(TrainConfig.from_dict({**config.to_dict(), "data": pinned,
+                                                      "max_steps": 9}), resume=True)
+    again.setup()
+    assert again.step == 9
     # Resuming with another learning rate would silently train something else.
     changed = TrainConfig.from_dict({**config.to_dict(), "optim": {**config.to_dict()["optim"],
                                                                    "lr": 1e-3}})
@@ -84,6 +86,17 @@ def test_a_run_killed_before_its_first_checkpoint_resumes_from_step_0(tiny_gemma
     assert resumed.step == 0 and len(resumed.train()) == 2
     log = (tmp_path / "run" / "train_log.jsonl").read_text().splitlines()
     assert [json.loads(x)["step"] for x in log] == [1, 2]
+
+
+def test_resume_refuses_a_folder_with_no_run_and_a_finished_run_without_checkpoints(
+        tiny_gemma_dir, tmp_path):
+    config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=1)
+    with pytest.raises(ConfigError, match="holds no run \\(no run.json\\): drop --resume"):
+        LoRAFinetuneRecipe(config, resume=True).setup()
+    run_training(config)
+    shutil.rmtree(tmp_path / "run" / "checkpoints")  # to save space
+    with pytest.raises(ConfigError, match="a finished run \\(adapter/\\) with no checkpoint"):
+        LoRAFinetuneRecipe(config, resume=True).setup()
 
 
 def test_too_few_records_for_one_optimizer_step_are_refused(tiny_gemma_dir, tmp_path):

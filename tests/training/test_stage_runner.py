@@ -142,6 +142,18 @@ def test_a_recipe_is_refused_in_several_processes(tmp_path, monkeypatch):
     assert not list(tmp_path.iterdir())
 
 
+def test_one_recipe_at_a_time_trains_in_a_folder(tmp_path):
+    """Tests the lock: a second `ara train` on a folder another one holds (a rerun
+    started while the first still trains) is refused before it touches anything."""
+    from ara.training.run_folder import exclusive
+
+    recipe = StagedRecipe.from_dict({"out": str(tmp_path), "stages": [
+        {"name": "a", "train": {}}]})
+    with exclusive(tmp_path), pytest.raises(ConfigError, match="another ara train is running"):
+        run_recipe(recipe)
+    assert [p.name for p in tmp_path.iterdir()] == [".lock"]
+
+
 def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         tiny_gemma_dir, paper_split, tmp_path):
     """Tests the runner end to end on a tiny Gemma 3: interrupted between stages, a rerun
@@ -237,9 +249,9 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
 
 @pytest.mark.slow  # a recipe in a subprocess, stopped as a scheduler stops it
 def test_a_recipe_stopped_with_sigterm_records_its_time_and_goes_on(tiny_gemma_dir, tmp_path):
-    """Tests `ara train --config RECIPE` stopped by SIGTERM (a scheduler, `timeout`, or
-    a background job, which ignores Ctrl-C): it ends as Ctrl-C does, exit 130 with
-    what to do, the stage's time recorded and its log whole; a rerun goes on."""
+    """Tests `ara train --config RECIPE` stopped by SIGTERM (a scheduler, `timeout`,
+    `kill`): it ends as Ctrl-C does, exit 143 with what to do, the stage's time recorded
+    and its log whole; a rerun goes on."""
     import signal
     import subprocess
     import sys
@@ -264,9 +276,9 @@ def test_a_recipe_stopped_with_sigterm_records_its_time_and_goes_on(tiny_gemma_d
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=120)
     stderr = errors.read_text()
-    assert proc.returncode == 130 and "interrupted: rerun the same command" in stderr, stderr
+    assert proc.returncode == 143 and "interrupted: rerun the same command" in stderr, stderr
     state = json.loads((out / "start" / "stage.json").read_text())
     assert state["done"] is False and state["sessions"] == 1 and state["wall_s"] > 0
-    lines = log.read_text().splitlines()
-    assert all(json.loads(line)["step"] for line in lines)  # every line whole
+    steps = [json.loads(line)["step"] for line in log.read_text().splitlines()]  # all whole
+    assert steps == list(range(1, len(steps) + 1)) and len(steps) >= 3
     assert whole_checkpoints(out / "start")  # checkpoint_every 1: it goes on from there
