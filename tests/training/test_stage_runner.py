@@ -240,7 +240,9 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     # Undoing the edit brings the set-aside stage back instead of training it again.
     lines.clear()
     run_recipe(StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out)), log=lines.append)
-    assert f"stage refine-b: brought back from {kept} (made with these settings)" in lines
+    (edited_folder,) = (out / "replaced").iterdir()  # the seed-3 one now waits there
+    assert (f"stage refine-b: brought back from {kept} (made with these settings); the "
+            f"folder in its place is kept as {edited_folder}") in lines
     assert "stage refine-b: done, skipped" in lines
     assert not [line for line in lines if line.startswith("stage refine-b: started")]
     assert "stage soup: started (soup)" in lines  # it was the edited one's soup
