@@ -5,7 +5,8 @@ parameters), but slowly: about a minute for its 262k-token tokenizer alone, and 
 model loaded from GGUF refuses ``save_pretrained``. So the conversion copies its state
 dict into a fresh ``Gemma3ForCausalLM(config)``, saves that with the tokenizer, and
 writes ``ara_model.json`` (source GGUF hash, versions) beside them. Later calls find
-the folder and return at once. Nothing is downloaded.
+the folder and return at once. Nothing is downloaded. Also the model's tokenizer, read
+once a process, and a base model with a saved LoRA adapter on it (a warm start).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ara import __version__
-from ara.errors import AraError
+from ara.errors import AraError, ConfigError
 from ara.provenance import cache_root, sha256_file
 
 MANIFEST = "ara_model.json"
@@ -118,3 +119,26 @@ def _tokenizer(model_dir: str, stamp: tuple):
 def _stamp(model_dir) -> tuple:
     return tuple(sorted((f.name, f.stat().st_mtime_ns, f.stat().st_size)
                         for f in Path(model_dir).glob("*token*")))
+
+
+def warm_started(base, folder: str, lora):
+    """``base`` with the trainable adapter saved in ``folder``, checked against ``lora``:
+    a warm start whose shape differs from the config would record one thing and train
+    another."""
+    from peft import PeftModel
+
+    model = PeftModel.from_pretrained(base, folder, is_trainable=True)
+    saved = model.peft_config["default"]
+    checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha),
+              ("dropout", saved.lora_dropout, lora.dropout)]
+    # A saved adapter lists the modules "all-linear" resolved to, so only an explicit
+    # list in the config can be compared with it.
+    if lora.target_modules != "all-linear":
+        checks.append(("target_modules", sorted(saved.target_modules),
+                       sorted(lora.target_modules)))
+    mismatched = {name: (got, want) for name, got, want in checks if got != want}
+    if mismatched:
+        detail = ", ".join(f"{k}: adapter {g} vs config {w}" for k, (g, w) in mismatched.items())
+        raise ConfigError(f"init_adapter {folder} has another LoRA shape ({detail}); "
+                          "set lora to the adapter's values")
+    return model

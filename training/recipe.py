@@ -36,7 +36,7 @@ from ara.training.dataset import (
     repeat_sources,
     shot_rng,
 )
-from ara.training.hf_model import load_tokenizer
+from ara.training.hf_model import load_tokenizer, warm_started
 from ara.training.run_folder import (
     adapter_identity,
     exclusive,
@@ -156,7 +156,7 @@ class LoRAFinetuneRecipe:
                                                     dtype=dtype)
         lora = self.config.lora
         if self.config.init_adapter:
-            return _warm_started(base, str(self.config.init_adapter_folder), lora)
+            return warm_started(base, str(self.config.init_adapter_folder), lora)
         return get_peft_model(base, LoraConfig(
             r=lora.r, lora_alpha=lora.alpha, lora_dropout=lora.dropout,
             target_modules=lora.target_modules, task_type="CAUSAL_LM"))
@@ -356,29 +356,6 @@ class LoRAFinetuneRecipe:
         return report
 
 
-def _warm_started(base, folder: str, lora):
-    """``base`` with the trainable adapter saved in ``folder``, checked against ``lora``:
-    a warm start whose shape differs from the config would record one thing and train
-    another."""
-    from peft import PeftModel
-
-    model = PeftModel.from_pretrained(base, folder, is_trainable=True)
-    saved = model.peft_config["default"]
-    checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha),
-              ("dropout", saved.lora_dropout, lora.dropout)]
-    # A saved adapter lists the modules "all-linear" resolved to, so only an explicit
-    # list in the config can be compared with it.
-    if lora.target_modules != "all-linear":
-        checks.append(("target_modules", sorted(saved.target_modules),
-                       sorted(lora.target_modules)))
-    mismatched = {name: (got, want) for name, got, want in checks if got != want}
-    if mismatched:
-        detail = ", ".join(f"{k}: adapter {g} vs config {w}" for k, (g, w) in mismatched.items())
-        raise ConfigError(f"init_adapter {folder} has another LoRA shape ({detail}); "
-                          "set lora to the adapter's values")
-    return model
-
-
 def run_training(config: TrainConfig, resume: bool = False) -> dict:
     """Train, save the adapter, run the held-out check; returns a summary."""
     with exclusive(Path(config.out)):
@@ -401,7 +378,8 @@ def _run_training(config: TrainConfig, resume: bool) -> dict:
 
 def main(config_path: str, max_steps: int | None = None, resume: bool = False) -> dict:
     """``ara train --config``: one run, or every stage of a staged recipe not yet done."""
-    from ara.training.stages import StagedRecipe, is_staged, run_recipe
+    from ara.training.stage_runner import run_recipe
+    from ara.training.stages import StagedRecipe, is_staged
 
     path = Path(config_path)
     if not path.is_file():

@@ -11,7 +11,8 @@ import yaml
 from ara.data import registered_version
 from ara.errors import ConfigError
 from ara.training.run_folder import whole_checkpoints
-from ara.training.stages import StagedRecipe, run_recipe
+from ara.training.stage_runner import run_recipe
+from ara.training.stages import StagedRecipe
 
 SHIPPED_RECIPE = Path(__file__).parents[2] / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
 

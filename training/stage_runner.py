@@ -1,0 +1,243 @@
+"""Running a staged recipe (:mod:`ara.training.stages`): each stage not done, in order.
+
+A rerun skips done stages, resumes an interrupted training stage from its newest
+checkpoint, and runs again, from scratch, a stage whose settings or inputs changed, so
+that every stage after an edited one is rebuilt too; a rebuilt training stage's old
+folder is set aside in ``OUT/replaced/`` and brought back when its settings return.
+``OUT/recipe.json`` records each stage's wall time and memory.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from ara.errors import ConfigError
+from ara.training.config import TrainConfig
+from ara.training.run_folder import exclusive, whole_checkpoints
+from ara.training.stages import REPLACED, Stage, StagedRecipe
+
+
+def _state(folder: Path) -> dict | None:
+    """A stage folder's record; ``None`` where it has none (or one a crash left unread-
+    able: the stage is then rebuilt, its folder set aside)."""
+    path = folder / "stage.json"
+    try:
+        return json.loads(path.read_text()) if path.is_file() else None
+    except json.JSONDecodeError:
+        return None
+
+
+def _write_state(folder: Path, state: dict) -> None:
+    """Replace the record whole: a kill leaves the old one or the new one."""
+    folder.mkdir(parents=True, exist_ok=True)
+    tmp = folder / "stage.json.tmp"
+    tmp.write_text(json.dumps(state, indent=2, sort_keys=True) + "\n")
+    tmp.replace(folder / "stage.json")
+
+
+def _peak_memory() -> dict:
+    """The process's resident high-water mark so far (MB), and the GPU's since the last
+    reset where there is one."""
+    rss_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    peak = {"peak_rss_mb": round(rss_kb / (1024 if sys.platform != "darwin" else 1024**2), 1)}
+    import torch
+
+    if torch.cuda.is_available():
+        peak["peak_cuda_mb"] = round(torch.cuda.max_memory_allocated() / 2**20, 1)
+        torch.cuda.reset_peak_memory_stats()
+    return peak
+
+
+def _stale(recipe: StagedRecipe, stage: Stage, state: dict | None, ran: set[str],
+           same: bool) -> str:
+    """Why the folder of ``stage`` cannot be kept, in words for the log (``same``: its
+    settings and inputs are those it was made with)."""
+    if same:
+        return ("it stopped before its first checkpoint" if stage.kind == "train"
+                else "it stopped before it was done")
+    if ran.intersection(stage.inputs):
+        return "a stage it reads was rebuilt"
+    run = recipe.folder(stage.name) / "run.json"
+    if stage.kind == "train" and run.is_file():
+        data = recipe.train_config(stage).data
+        trained = json.loads(run.read_text())["data"]["version"]
+        wanted = data.resolved_version()
+        if trained != wanted:
+            return (f"it was trained on {data.split} version {trained} and this run asks for "
+                    f"{wanted} (to keep it, pin data.version: {trained} in the config, "
+                    "where that version is still prepared)")
+    if state is None:
+        return "its folder holds no stage record"
+    return "its settings changed" if run.is_file() or stage.kind != "train" else (
+        "it stopped before its run began")
+
+
+def _has_training(folder: Path) -> bool:
+    return (folder / "adapter").is_dir() or bool(whole_checkpoints(folder))
+
+
+def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
+    """Move a stage's folder under ``out/replaced/``, named by when it was replaced."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    dest, n = recipe.out / REPLACED / f"{folder.name}-{stamp}", 1
+    while dest.exists():
+        n += 1
+        dest = dest.with_name(f"{folder.name}-{stamp}-{n}")
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    shutil.move(str(folder), str(dest))
+    return dest
+
+
+def _write_record(path: Path, record: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+
+
+def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | None:
+    """Bring back the newest folder of stage ``name`` set aside with this very
+    fingerprint (an edit undone, a data version pinned again), done or resumable,
+    setting aside what stands in its place; returns its stage record, else ``None``."""
+    folder = recipe.folder(name)
+    if (_state(folder) or {}).get("fingerprint") == fingerprint:
+        return None
+    for old in sorted((recipe.out / REPLACED).glob(f"{name}-*"), reverse=True):
+        state = _state(old)
+        if state and state.get("name") == name and state.get("fingerprint") == fingerprint \
+                and (state.get("done") or whole_checkpoints(old)):
+            kept = None
+            if folder.exists():
+                if _has_training(folder):
+                    kept = _set_aside(recipe, folder)
+                else:
+                    shutil.rmtree(folder)
+            shutil.move(str(old), str(folder))
+            log(f"stage {name}: brought back from {old} (made with these settings)"
+                + (f"; the folder in its place is kept as {kept}" if kept else ""))
+            return state
+    return None
+
+
+def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
+               max_steps: int | None) -> dict:
+    folder = recipe.folder(stage.name)
+    if stage.kind == "train":
+        from ara.training.recipe import run_training
+
+        config = recipe.train_config(stage)
+        if max_steps is not None:
+            capped = min(config.max_steps or max_steps, max_steps)
+            config = TrainConfig.from_dict({**config.to_dict(), "max_steps": capped})
+        return run_training(config, resume)
+    if stage.kind == "soup":
+        from ara.training.soup import soup_runs
+
+        record = soup_runs([recipe.folder(name) for name in stage.inputs],
+                           stage.settings.get("weights"), folder, stage.settings.get("rank"))
+        return {k: record[k] for k in ("soup", "reduced") if k in record}
+    from ara.training.export import export_checked
+
+    source = recipe.folder(stage.inputs[0])
+    manifest = export_checked(source, ("f16",), lora_gguf=True,
+                              parity_pairs=stage.settings.get("parity", 20))
+    # The export lives in its own stage folder, so that rerunning it leaves the
+    # adapter it read alone.
+    if folder.exists():
+        shutil.rmtree(folder)
+    shutil.move(str(source / "export"), str(folder))
+    # With the record of the run it exports and its adapter (shipped as PEFT beside the
+    # GGUF), the folder is all that shipping needs.
+    shutil.copyfile(source / "run.json", folder / "run.json")
+    shutil.copytree(source / "adapter", folder / "adapter")
+    return {"files": manifest["files"], "parity": manifest.get("parity")}
+
+
+def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) -> dict:
+    """Run the stages that are not done; returns the recipe's record (``recipe.json``).
+    One at a time on a recipe's folder (:func:`~ara.training.run_folder.exclusive`).
+
+    Args:
+        recipe: The stages.
+        max_steps: Cap every training stage at this many steps (a smoke run); the cap is
+            part of each stage's fingerprint, so a later full run starts them again.
+        log: Where a line per stage goes.
+    """
+    if int(os.environ.get("WORLD_SIZE", "1")) > 1:
+        # Every process would set stages aside, write their records, soup and export.
+        raise ConfigError("a staged recipe runs in one process (its stage records, soups and "
+                          "exports are written once): run it on one GPU "
+                          "(scripts/train_gpu.sh does), or give several a single-run config")
+    with exclusive(recipe.out):
+        return _run_recipe(recipe, max_steps, log)
+
+
+def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
+    prints = recipe.fingerprints()
+    if max_steps is not None:
+        prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}
+    record_path = recipe.out / "recipe.json"
+    record = json.loads(record_path.read_text()) if record_path.is_file() else {}
+    record.setdefault("stages", {})
+    ran: set[str] = set()
+    for stage in recipe.stages:
+        if stage.kind == "train" and not ran.intersection(stage.inputs):
+            restored = _restore(recipe, stage.name, prints[stage.name], log)
+            if restored is not None and restored.get("done"):
+                record["stages"][stage.name] = {k: v for k, v in restored.items()
+                                                if k != "done"}
+                _write_record(record_path, record)
+        folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
+        same = bool(state and state.get("fingerprint") == prints[stage.name]
+                    and not ran.intersection(stage.inputs))
+        if same and state.get("done"):
+            # Held-out checks do not change the adapter, so a stage trained without one
+            # (on a box without Spot) stays done; say so rather than leave it unnoticed.
+            unchecked = (stage.kind == "train" and recipe.train_config(stage).eval_pairs
+                         and not (folder / "heldout.json").is_file())
+            log(f"stage {stage.name}: done, skipped"
+                + (" (trained without the held-out check)" if unchecked else ""))
+            continue
+        # A training stage killed before its first checkpoint has nothing to resume from.
+        resume = same and stage.kind == "train" and bool(whole_checkpoints(folder))
+        if folder.exists() and not resume:
+            # Made with other settings or from other inputs (it would mix two recipes), or
+            # cut short before anything in it could be resumed.
+            why = _stale(recipe, stage, state, ran, same)
+            kept = (_set_aside(recipe, folder)
+                    if stage.kind == "train" and _has_training(folder) else None)
+            if kept is None:
+                shutil.rmtree(folder)
+            log(f"stage {stage.name}: {why}; rebuilding it"
+                + (f" (the old folder is kept as {kept}; delete it once unneeded)" if kept
+                   else ""))
+            record["stages"].pop(stage.name, None)
+        log(f"stage {stage.name}: {'resumed' if resume else 'started'} ({stage.kind})")
+        before = {"wall_s": state.get("wall_s", 0.0), "sessions": state.get("sessions", 0)} \
+            if resume else {"wall_s": 0.0, "sessions": 0}
+        head = {"name": stage.name, "kind": stage.kind, "inputs": list(stage.inputs),
+                "fingerprint": prints[stage.name]}
+        _write_state(folder, {**head, **before, "done": False})
+        start = time.perf_counter()
+        try:
+            result = _run_stage(recipe, stage, resume, max_steps)
+        except BaseException:
+            # An interrupted stage keeps the time it took, which its resumption adds to.
+            if folder.exists():
+                _write_state(folder, {**head, "done": False, "sessions": before["sessions"] + 1,
+                                      "wall_s": round(before["wall_s"] + time.perf_counter()
+                                                      - start, 1)})
+            raise
+        wall = time.perf_counter() - start
+        entry = {**head, "wall_s": round(before["wall_s"] + wall, 1),
+                 "sessions": before["sessions"] + 1, **_peak_memory(), "result": result}
+        _write_state(recipe.folder(stage.name), {**entry, "done": True})
+        record["stages"][stage.name] = entry
+        ran.add(stage.name)
+        _write_record(record_path, record)
+        log(f"stage {stage.name}: done in {wall:.0f} s")
+    return record
