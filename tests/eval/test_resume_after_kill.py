@@ -24,6 +24,7 @@ def answers(folder):
                   for s in samples(folder))
 
 
+@pytest.mark.slow  # four runs of the model; the default tier resumes cut logs in test_run_store
 @pytest.mark.usefixtures("embedded_model_path", "paper_split")
 def test_resume_after_sigkill_matches_an_uninterrupted_run(tmp_path):
     """Tests resume: kill a real run mid-way, resume it, compare with a clean run."""

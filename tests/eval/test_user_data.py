@@ -157,9 +157,9 @@ def test_cli_names_what_cannot_be_planned_before_loading_a_model(tmp_path):
     assert not (tmp_path / "run").exists()
 
 
-# A second ablation in a subprocess (test_resume_after_kill runs one for real);
-# reading and planning your own file are tested above without a model.
-@pytest.mark.slow
+# The default tier's real ablation, end to end in a subprocess (test_resume_after_kill,
+# in the slow tier, kills and resumes one); reading and planning your own file are
+# tested above without a model.
 @needs_llama
 def test_an_ablation_on_ones_own_file_is_judged_reported_and_resumed(tmp_path):
     """Tests a real run on a user's file: every line translated under C and zero-shot

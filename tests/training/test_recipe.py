@@ -135,7 +135,7 @@ def test_steps_that_span_an_epoch_end_resume_where_they_stood(tiny_gemma_dir, tm
     assert resumed.train() == pytest.approx(uninterrupted[3:], rel=1e-4)
 
 
-@pytest.mark.slow  # the harness runs a real model by default (test_resume_after_kill)
+@pytest.mark.slow  # the harness runs a real model by default (test_user_data)
 def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path):
     """Tests the saved adapter and the held-out check, with prompts of 0 and 2 worked
     examples: even random weights give valid formulas under the grammar."""
