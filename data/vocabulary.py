@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import random
 from dataclasses import dataclass
+from functools import cache
 
 PLACES = (
     ("kitchen", "kitchen"), ("hallway", "hallway"), ("office", "office"), ("lab", "lab"),
@@ -221,12 +222,13 @@ def _draw_lasting(rng: random.Random) -> Proposition:
     return Proposition(verb, dict(STANDALONE_ACTIONS)[verb], action=True, lasting=True)
 
 
+@cache
 def kept_states() -> tuple[tuple[str, str, str], ...]:
     """Every (name, subject, state) :data:`KEPT_PHRASES` may say."""
     switched = tuple((f"{x}_{st}", x, st) for x in SWITCHED for st in ("on", "off"))
     opened = tuple((f"{x}_{st}", x, st) for x in OPENED for st in ("open", "closed"))
     locked = tuple((f"{x}_locked", x, "locked") for x in LOCKED)
-    things = tuple((f"{name.replace(' ', '_')}", f"the {x.replace('_', ' ')}", st)
+    things = tuple((name, f"the {x.replace('_', ' ')}", st)
                    for name, x, st in switched + opened + locked)
     return things + KEPT_THINGS
 

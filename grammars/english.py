@@ -434,8 +434,7 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
     if isinstance(f, Until):
         # A proposition said in words reads only before "until": not "keep hold the box
         # until ...", "the door is open holds until ...".
-        worded = r.in_words
-        allow = (lambda p: p.startswith(("{a} until", "{a} up to"))) if worded else None
+        allow = (lambda p: p.startswith(("{a} until", "{a} up to"))) if r.in_words else None
         if f.interval is None:
             return r.pick("U()" if embedded else "U", used, allow=allow, a=sub(f.lhs),
                           b=sub(f.rhs))

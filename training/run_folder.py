@@ -12,7 +12,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ara.errors import ConfigError
-from ara.provenance import differing
+from ara.provenance import differing, sha256_file
 from ara.training.config import BOOKKEEPING, TrainConfig
 
 
@@ -69,8 +69,6 @@ def refuse_changed_config(run_json: Path, config: TrainConfig) -> None:
 def refuse_changed_data(run_json: Path, data, loaded: str) -> None:
     """A resumed run goes on with the data it started on: the version this release loads
     for its config (``data``) and the user's pairs file as they were."""
-    from ara.provenance import sha256_file
-
     started = json.loads(run_json.read_text())["data"]
     if started["version"] != loaded:
         raise ConfigError(
@@ -86,8 +84,6 @@ def adapter_identity(folder: str | Path | None) -> dict | None:
     """Where a warm start came from: the folder and its weights' hash."""
     if not folder:
         return None
-    from ara.provenance import sha256_file
-
     weights = sorted(Path(folder).glob("adapter_model.*"))
     digest = sha256_file(weights[0]) if weights else None
     return {"path": str(folder), "sha256": digest}

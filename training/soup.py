@@ -44,8 +44,7 @@ class SoupPart:
     weight: float = 1.0
 
     def __post_init__(self) -> None:
-        if not math.isfinite(self.weight) or self.weight <= 0:
-            raise ConfigError(f"a soup weight must be a positive number, got {self.weight}")
+        _check_weight(self.weight)
 
 
 def _load(adapter: Path) -> tuple[dict, dict]:
@@ -192,16 +191,20 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
     return record
 
 
+def _check_weight(weight) -> None:
+    if not isinstance(weight, (int, float)) or not math.isfinite(weight) or weight <= 0:
+        raise ConfigError(f"a soup weight must be a positive number, got {weight!r}")
+
+
 def check_soup(parts: int, weights: list | None, rank: int | None, noun: str = "run") -> None:
     """A soup's settings, before anything is read: ``weights`` one positive number per
     part, at least two parts or one and a ``rank`` (a positive whole number)."""
     if weights is not None:
-        if not isinstance(weights, list) or len(weights) != parts:
-            count = len(weights) if isinstance(weights, list) else weights
+        if not isinstance(weights, (list, tuple)) or len(weights) != parts:
+            count = len(weights) if isinstance(weights, (list, tuple)) else weights
             raise ConfigError(f"{count} weights for {parts} {noun}s: one per {noun}, in order")
         for w in weights:
-            if not isinstance(w, (int, float)) or not math.isfinite(w) or w <= 0:
-                raise ConfigError(f"a soup weight must be a positive number, got {w!r}")
+            _check_weight(w)
     if parts < 2 and rank is None:
         raise ConfigError(f"a soup needs at least two {noun}s (or one and a rank to reduce "
                           "it to)")

@@ -33,12 +33,16 @@ def _state(folder: Path) -> dict | None:
         return None
 
 
+def _write_json(path: Path, data: dict) -> None:
+    """Replace the file whole: a kill leaves the old one or the new one."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
+    tmp.replace(path)
+
+
 def _write_state(folder: Path, state: dict) -> None:
-    """Replace the record whole: a kill leaves the old one or the new one."""
-    folder.mkdir(parents=True, exist_ok=True)
-    tmp = folder / "stage.json.tmp"
-    tmp.write_text(json.dumps(state, indent=2, sort_keys=True) + "\n")
-    tmp.replace(folder / "stage.json")
+    _write_json(folder / "stage.json", state)
 
 
 def _peak_memory() -> dict:
@@ -82,6 +86,15 @@ def _has_training(folder: Path) -> bool:
     return (folder / "adapter").is_dir() or bool(whole_checkpoints(folder))
 
 
+def _make_room(recipe: StagedRecipe, folder: Path, kind: str) -> Path | None:
+    """Clear a stage's folder for another: one that holds training is set aside (where
+    it went is returned), anything else removed."""
+    if kind == "train" and _has_training(folder):
+        return _set_aside(recipe, folder)
+    shutil.rmtree(folder)
+    return None
+
+
 def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
     """Move a stage's folder under ``out/replaced/``, named by when it was replaced."""
     stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -92,11 +105,6 @@ def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
     dest.parent.mkdir(parents=True, exist_ok=True)
     shutil.move(str(folder), str(dest))
     return dest
-
-
-def _write_record(path: Path, record: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
 
 
 def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | None:
@@ -110,12 +118,7 @@ def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | N
         state = _state(old)
         if state and state.get("name") == name and state.get("fingerprint") == fingerprint \
                 and (state.get("done") or whole_checkpoints(old)):
-            kept = None
-            if folder.exists():
-                if _has_training(folder):
-                    kept = _set_aside(recipe, folder)
-                else:
-                    shutil.rmtree(folder)
+            kept = _make_room(recipe, folder, "train") if folder.exists() else None
             shutil.move(str(old), str(folder))
             log(f"stage {name}: brought back from {old} (made with these settings)"
                 + (f"; the folder in its place is kept as {kept}" if kept else ""))
@@ -190,7 +193,7 @@ def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
             if restored is not None and restored.get("done"):
                 record["stages"][stage.name] = {k: v for k, v in restored.items()
                                                 if k != "done"}
-                _write_record(record_path, record)
+                _write_json(record_path, record)
         folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
         same = bool(state and state.get("fingerprint") == prints[stage.name]
                     and not ran.intersection(stage.inputs))
@@ -208,10 +211,7 @@ def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
             # Made with other settings or from other inputs (it would mix two recipes), or
             # cut short before anything in it could be resumed.
             why = _stale(recipe, stage, state, ran, same)
-            kept = (_set_aside(recipe, folder)
-                    if stage.kind == "train" and _has_training(folder) else None)
-            if kept is None:
-                shutil.rmtree(folder)
+            kept = _make_room(recipe, folder, stage.kind)
             log(f"stage {stage.name}: {why}; rebuilding it"
                 + (f" (the old folder is kept as {kept}; delete it once unneeded)" if kept
                    else ""))
@@ -238,6 +238,6 @@ def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
         _write_state(recipe.folder(stage.name), {**entry, "done": True})
         record["stages"][stage.name] = entry
         ran.add(stage.name)
-        _write_record(record_path, record)
+        _write_json(record_path, record)
         log(f"stage {stage.name}: done in {wall:.0f} s")
     return record
