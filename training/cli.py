@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import user_errors
+from ara.training.export import PARITY_PAIRS
 
 model_app = typer.Typer(help="Prepare base models (no downloads).", no_args_is_help=True)
 
@@ -106,7 +107,7 @@ def export_cmd(
     quant: str = typer.Option("f16,q8_0,q4_k_m", "--quant",
                               help="Comma list of GGUF types: f32, f16, q8_0, q4_k_m, ..."),
     lora_gguf: bool = typer.Option(False, "--lora-gguf", help="Also the adapter as GGUF LoRA."),
-    parity_pairs: int = typer.Option(20, "--parity",
+    parity_pairs: int = typer.Option(PARITY_PAIRS, "--parity",
                                      help="Test pairs for the GGUF vs HF greedy check (0: skip)."),
 ) -> None:
     """Merge the adapter into the base, convert to GGUF, quantize, check parity."""

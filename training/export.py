@@ -28,6 +28,8 @@ from ara.errors import AraError
 from ara.provenance import cache_root, sha256_file
 
 #: llama.cpp quantization types by name (``llama_ftype`` values).
+#: Test pairs the greedy parity check of an export compares by default (0: none).
+PARITY_PAIRS = 20
 QUANT_TYPES = {"f32": 0, "f16": 1, "q8_0": 7, "q4_k_m": 15, "q5_k_m": 17, "q6_k": 18}
 
 
@@ -159,7 +161,7 @@ def parity(gguf: Path, hf_dir: Path, records, lora: Path | None = None,
 
 
 def export_checked(run_dir: Path, quants: tuple[str, ...] | list[str] = ("f16",),
-                   lora_gguf: bool = False, parity_pairs: int = 20) -> dict:
+                   lora_gguf: bool = False, parity_pairs: int = PARITY_PAIRS) -> dict:
     """:func:`export_run`, then the greedy parity of the GGUF and the merged HF model on
     the first ``parity_pairs`` test pairs of the data version the run trained on (0: no
     check); the manifest, with ``parity``, is ``run_dir/export/export.json``."""

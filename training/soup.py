@@ -192,7 +192,8 @@ def reduce_rank(adapter: Path, rank: int, out: Path) -> dict:
 
 
 def _check_weight(weight) -> None:
-    if not isinstance(weight, (int, float)) or not math.isfinite(weight) or weight <= 0:
+    if (not isinstance(weight, (int, float)) or isinstance(weight, bool)
+            or not math.isfinite(weight) or weight <= 0):
         raise ConfigError(f"a soup weight must be a positive number, got {weight!r}")
 
 
@@ -208,7 +209,7 @@ def check_soup(parts: int, weights: list | None, rank: int | None, noun: str = "
     if parts < 2 and rank is None:
         raise ConfigError(f"a soup needs at least two {noun}s (or one and a rank to reduce "
                           "it to)")
-    if rank is not None and (not isinstance(rank, int) or rank < 1):
+    if rank is not None and (not isinstance(rank, int) or isinstance(rank, bool) or rank < 1):
         raise ConfigError(f"a reduced rank is a positive whole number, got {rank!r}")
 
 

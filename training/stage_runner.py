@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
+from ara.training.export import PARITY_PAIRS, export_checked
 from ara.training.run_folder import exclusive, whole_checkpoints
 from ara.training.stages import REPLACED, Stage, StagedRecipe
 
@@ -143,11 +144,9 @@ def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
         record = soup_runs([recipe.folder(name) for name in stage.inputs],
                            stage.settings.get("weights"), folder, stage.settings.get("rank"))
         return {k: record[k] for k in ("soup", "reduced") if k in record}
-    from ara.training.export import export_checked
-
     source = recipe.folder(stage.inputs[0])
     manifest = export_checked(source, ("f16",), lora_gguf=True,
-                              parity_pairs=stage.settings.get("parity", 20))
+                              parity_pairs=stage.settings.get("parity", PARITY_PAIRS))
     # The export lives in its own stage folder, so that rerunning it leaves the
     # adapter it read alone.
     if folder.exists():

@@ -30,6 +30,7 @@ from typing import Any
 
 from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
 from ara.training.config import BOOKKEEPING, TrainConfig
+from ara.training.export import PARITY_PAIRS
 from ara.training.run_folder import adapter_identity
 from ara.training.soup import check_soup
 
@@ -192,8 +193,8 @@ def _stage(item: Any) -> Stage:
                               f"got {source!r}")
         inputs = (source,)
         settings = {k: item.pop(k) for k in ("parity",) if k in item}
-        parity = settings.get("parity", 20)
-        if not isinstance(parity, int) or parity < 0:
+        parity = settings.get("parity", PARITY_PAIRS)
+        if not isinstance(parity, int) or isinstance(parity, bool) or parity < 0:
             raise ConfigError(f"stage {name}: parity is a number of test pairs (0: no "
                               f"check), got {parity!r}")
     if item:

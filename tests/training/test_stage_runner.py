@@ -119,6 +119,13 @@ def test_a_stage_is_what_its_files_hold_not_their_names(tmp_path):
       {"name": "s", "soup": ["a", "b"], "weights": [1]}], "s: 1 weights for 2 stages"),
     ([{"name": "a", "train": {}}, {"name": "e", "export": "a", "parity": -1}],
      "parity is a number of test pairs"),
+    # YAML's yes/true is a bool, which Python counts as the number 1.
+    ([{"name": "a", "train": {}}, {"name": "e", "export": "a", "parity": True}],
+     "parity is a number of test pairs"),
+    ([{"name": "a", "train": {}}, {"name": "b", "train": {}},
+      {"name": "s", "soup": ["a", "b"], "weights": [True, 1]}], "weight"),
+    ([{"name": "a", "train": {}}, {"name": "s", "soup": ["a"], "rank": True}],
+     "a reduced rank is a positive whole number"),
     ([{"name": "a", "train": {}}, {"name": "s", "soup": ["a"]}],
      "a soup needs at least two stages"),
     ([{"name": "a", "train": {}}, {"name": "e", "export": "a"}, {"name": "f", "export": "e"}],
