@@ -41,6 +41,11 @@ def train_cmd(
         False, "--resume",
         help="Continue a single run from its newest checkpoint (a recipe always goes on "
              "where it stopped)."),
+    status: bool = typer.Option(
+        False, "--status",
+        help="Train nothing: show where a staged recipe stands (what a rerun would do "
+             "with each stage, steps done, hours left at the logged pace)."),
+    as_json: bool = typer.Option(False, "--json", help="With --status: one JSON object."),
 ) -> None:
     """LoRA fine-tuning (transformers + peft + accelerate) with the eval prompt format.
 
@@ -53,6 +58,11 @@ def train_cmd(
     import signal
 
     from ara.training.recipe import main
+
+    if status:
+        with user_errors():
+            _print_status(config, as_json)
+        return
 
     # A scheduler, `timeout` or `kill` stops a run with SIGTERM: it now ends as Ctrl-C
     # does, so a recipe records the time the stage took and the log ends on a whole line.
@@ -73,6 +83,42 @@ def train_cmd(
     finally:
         signal.signal(signal.SIGTERM, before)
     typer.echo(json.dumps(summary, indent=2))
+
+
+def _print_status(config: Path, as_json: bool) -> None:
+    import yaml
+
+    from ara.cli_support import emit
+    from ara.errors import ConfigError
+    from ara.training.stage_runner import recipe_status
+    from ara.training.stages import StagedRecipe, is_staged
+
+    if not config.is_file():
+        raise ConfigError(f"config file not found: {config}")
+    data = yaml.safe_load(config.read_text()) or {}
+    if not is_staged(data):
+        raise ConfigError(f"{config} is a single run, not a staged recipe: its progress is "
+                          "in OUT/train_log.jsonl (a line a step) and OUT/checkpoints/")
+    emit(recipe_status(StagedRecipe.from_dict(data)), as_json, _status_table)
+
+
+def _status_table(status: dict) -> str:
+    lines = [status["out"] + (" (an ara train is running on it now)" if status["running"]
+                              else ""),
+             "| stage | kind | steps | state: what a rerun does |", "|---|---|---:|---|"]
+    for row in status["stages"]:
+        steps = ("" if row["kind"] != "train" else
+                 f"{row['steps_done']:,} / {row['steps_total'] or '?':,}"
+                 if row["steps_total"] else f"{row['steps_done']:,} / ?")
+        lines.append(f"| {row['name']} | {row['kind']} | {steps} | {row['state']} |")
+    left = f"{status['steps_left']:,}" + (" or more" if status["steps_left_unknown"] else "")
+    pace = status["seconds_per_step"]
+    lines.append("\n" + (f"{left} training steps left: about {status['hours_left']:.1f} h at "
+                          f"{pace:.1f} s a step (the median of the last 200 logged here), "
+                          "besides held-out checks, soups and the export"
+                          if pace else f"{left} training steps left (no step logged yet "
+                          "to time them)"))
+    return "\n".join(lines)
 
 
 def soup_cmd(

@@ -124,13 +124,13 @@ def _stamp(model_dir) -> tuple:
 def warm_started(base, folder: str, lora):
     """``base`` with the trainable adapter saved in ``folder``, checked against ``lora``:
     a warm start whose shape differs from the config would record one thing and train
-    another."""
-    from peft import PeftModel
+    another. Dropout is no part of the shape: the run trains with the config's."""
+    from peft import LoraConfig, PeftModel
 
-    model = PeftModel.from_pretrained(base, folder, is_trainable=True)
-    saved = model.peft_config["default"]
-    checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha),
-              ("dropout", saved.lora_dropout, lora.dropout)]
+    saved = LoraConfig.from_pretrained(folder)
+    saved.lora_dropout = lora.dropout
+    model = PeftModel.from_pretrained(base, folder, is_trainable=True, config=saved)
+    checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha)]
     # A saved adapter lists the modules "all-linear" resolved to, so only an explicit
     # list in the config can be compared with it.
     if lora.target_modules != "all-linear":

@@ -35,6 +35,20 @@ def exclusive(out: Path) -> Iterator[None]:
         yield
 
 
+def held(out: Path) -> bool:
+    """Whether an ``ara train`` holds ``out`` now (see :func:`exclusive`)."""
+    lock = Path(out) / ".lock"
+    if not lock.is_file():
+        return False
+    with open(lock) as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return True
+        fcntl.flock(handle, fcntl.LOCK_UN)
+        return False
+
+
 def whole_checkpoints(out: Path) -> list[Path]:
     """The whole checkpoints of run folder ``out`` (``step.json`` is written last, so a
     checkpoint a kill cut short has none), oldest first."""

@@ -13,6 +13,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -20,7 +21,7 @@ from pathlib import Path
 from ara.errors import ConfigError
 from ara.training.config import TrainConfig
 from ara.training.export import PARITY_PAIRS, export_checked
-from ara.training.run_folder import exclusive, whole_checkpoints
+from ara.training.run_folder import exclusive, held, whole_checkpoints
 from ara.training.stages import REPLACED, Stage, StagedRecipe
 
 
@@ -113,17 +114,28 @@ def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | N
     fingerprint (an edit undone, a data version pinned again), done or resumable,
     setting aside what stands in its place; returns its stage record, else ``None``."""
     folder = recipe.folder(name)
-    if (_state(folder) or {}).get("fingerprint") == fingerprint:
+    found = _set_aside_match(recipe, name, fingerprint)
+    if found is None:
+        return None
+    old, state = found
+    kept = _make_room(recipe, folder, "train") if folder.exists() else None
+    shutil.move(str(old), str(folder))
+    log(f"stage {name}: brought back from {old} (made with these settings)"
+        + (f"; the folder in its place is kept as {kept}" if kept else ""))
+    return state
+
+
+def _set_aside_match(recipe: StagedRecipe, name: str,
+                     fingerprint: str) -> tuple[Path, dict] | None:
+    """The newest folder of stage ``name`` set aside with ``fingerprint``, done or
+    resumable, and its record; ``None`` where the stage's own folder has it already."""
+    if (_state(recipe.folder(name)) or {}).get("fingerprint") == fingerprint:
         return None
     for old in sorted((recipe.out / REPLACED).glob(f"{name}-*"), reverse=True):
         state = _state(old)
         if state and state.get("name") == name and state.get("fingerprint") == fingerprint \
                 and (state.get("done") or whole_checkpoints(old)):
-            kept = _make_room(recipe, folder, "train") if folder.exists() else None
-            shutil.move(str(old), str(folder))
-            log(f"stage {name}: brought back from {old} (made with these settings)"
-                + (f"; the folder in its place is kept as {kept}" if kept else ""))
-            return state
+            return old, state
     return None
 
 
@@ -240,3 +252,75 @@ def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
         _write_json(record_path, record)
         log(f"stage {stage.name}: done in {wall:.0f} s")
     return record
+
+
+def recipe_status(recipe: StagedRecipe) -> dict:
+    """Where a recipe stands, read from its folder without changing anything: what a
+    rerun would do with each stage (skip it, resume it from a checkpoint, bring it back
+    from ``replaced/``, or run it, and why), each training stage's steps, and the
+    training steps left at the pace its logs show."""
+    prints = recipe.fingerprints()
+    running = held(recipe.out)
+    pending: set[str] = set()  # stages a rerun runs: whatever reads them runs again
+    rows, seconds = [], []
+    for stage in recipe.stages:
+        folder = recipe.folder(stage.name)
+        state = _state(folder)
+        waits = [name for name in stage.inputs if name in pending]
+        same = bool(state and state.get("fingerprint") == prints[stage.name] and not waits)
+        found = (_set_aside_match(recipe, stage.name, prints[stage.name])
+                 if stage.kind == "train" and not waits else None)
+        if found is not None:
+            folder, state, same = found[0], found[1], True
+        checkpoints = whole_checkpoints(folder) if same and stage.kind == "train" else []
+        kept = int(checkpoints[-1].name.split("_")[1]) if checkpoints else 0
+        done = same and bool(state.get("done"))
+        if done:
+            says = "done"
+        elif checkpoints:
+            says = (f"training now (checkpoint at step {kept})" if running and not pending
+                    else f"resumes from step {kept}")
+        elif waits:
+            says = f"runs {'again ' if folder.exists() else ''}after {', '.join(waits)}"
+        elif folder.exists():
+            says = f"runs again: {_stale(recipe, stage, state, pending, same)}"
+        else:
+            says = "to run"
+        if found is not None:
+            says += f" (brought back from {found[0].name})"
+        row = {"name": stage.name, "kind": stage.kind, "state": says, "steps_done": None,
+               "steps_total": None, "steps_left": None}
+        if stage.kind == "train":
+            config = recipe.train_config(stage)
+            total = _total_steps(folder / "run.json", config) if same else config.max_steps
+            log = folder / "train_log.jsonl"
+            logged = [json.loads(line) for line in log.read_text().splitlines()
+                      if line.endswith("}")] if same and log.is_file() else []
+            seconds += [r["seconds"] for r in logged]
+            # Steps kept: the newest checkpoint's (a rerun redoes those after it), or,
+            # while this stage trains, the steps logged so far.
+            steps = total if done else kept
+            if running and not pending and logged:
+                steps = max(steps, logged[-1]["step"])
+            row.update(steps_done=steps, steps_total=total,
+                       steps_left=None if total is None else total - steps)
+        if not done:
+            pending.add(stage.name)
+        rows.append(row)
+    pace = statistics.median(seconds[-200:]) if seconds else None
+    left = [r["steps_left"] for r in rows if r["kind"] == "train"]
+    known = sum(n for n in left if n is not None)
+    return {"out": str(recipe.out), "running": running, "stages": rows,
+            "seconds_per_step": pace, "steps_left": known,
+            "steps_left_unknown": any(n is None for n in left),
+            "hours_left": None if pace is None else round(known * pace / 3600, 2)}
+
+
+def _total_steps(run_json: Path, config: TrainConfig) -> int | None:
+    """A started run's steps, from the training records its ``run.json`` counted."""
+    if not run_json.is_file():
+        return config.max_steps
+    examples = json.loads(run_json.read_text())["data"]["train_examples"]
+    optim = config.optim
+    total = -(-examples // optim.batch_size) * optim.epochs // optim.grad_accum
+    return min(total, config.max_steps or total)

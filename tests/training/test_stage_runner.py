@@ -11,7 +11,7 @@ import yaml
 from ara.data import registered_version
 from ara.errors import ConfigError
 from ara.training.run_folder import whole_checkpoints
-from ara.training.stage_runner import run_recipe
+from ara.training.stage_runner import recipe_status, run_recipe
 from ara.training.stages import StagedRecipe
 
 SHIPPED_RECIPE = Path(__file__).parents[2] / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
@@ -178,6 +178,14 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         run_recipe(recipe, log=stop_at_refine_a)
     assert json.loads((out / "start" / "stage.json").read_text())["done"] is True
     assert not (out / "refine-a").exists()
+    # `ara train --status` reads where it stands, changing nothing.
+    status = recipe_status(recipe)
+    assert [(r["name"], r["state"], r["steps_done"], r["steps_total"])
+            for r in status["stages"]] == [
+        ("start", "done", 2, 2), ("refine-a", "to run", 0, 1), ("refine-b", "to run", 0, 1),
+        ("soup", "runs after refine-a, refine-b", None, None)]
+    assert status["steps_left"] == 2 and status["seconds_per_step"] > 0
+    assert not status["running"] and not (out / "refine-a").exists()
 
     lines: list[str] = []
     record = run_recipe(recipe, log=lines.append)
@@ -206,6 +214,8 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     (out / "refine-b" / "stage.json").write_text(json.dumps({**state, "done": False}))
     for part in ("checkpoints", "adapter"):
         shutil.rmtree(out / "refine-b" / part)
+    assert [r["state"] for r in recipe_status(recipe)["stages"]][2:] == [
+        "runs again: it stopped before its first checkpoint", "runs again after refine-b"]
     lines.clear()
     run_recipe(recipe, log=lines.append)
     assert "stage refine-b: it stopped before its first checkpoint; rebuilding it" in lines
@@ -228,6 +238,9 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     run = json.loads(run_json.read_text())
     run_json.write_text(json.dumps({**run, "data": {**run["data"], "version": "000000000000"}}))
     edited = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out, refine_b_seed=3))
+    states = [r["state"] for r in recipe_status(edited)["stages"]]
+    assert states[:2] == ["done", "done"] and states[3] == "runs again after refine-b"
+    assert states[2].startswith("runs again: it was trained on paper version 000000000000")
     lines.clear()
     run_recipe(edited, log=lines.append)
     assert [line for line in lines if "skipped" in line] == [
@@ -246,6 +259,8 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     assert (out / "soup" / "adapter" / "adapter_model.safetensors").read_bytes() != soup_before
 
     # Undoing the edit brings the set-aside stage back instead of training it again.
+    undone = StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out))
+    assert recipe_status(undone)["stages"][2]["state"] == f"done (brought back from {kept.name})"
     lines.clear()
     run_recipe(StagedRecipe.from_dict(tiny_recipe(tiny_gemma_dir, out)), log=lines.append)
     (edited_folder,) = (out / "replaced").iterdir()  # the seed-3 one now waits there
