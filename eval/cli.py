@@ -163,7 +163,7 @@ def translate_file_cmd(
     resume: bool = typer.Option(False, "--resume",
                                 help="Go on with an --out an interrupted run left, made "
                                      "with the same options (kept beside it, in "
-                                     "OUT.settings.json)."),
+                                     "OUT with .settings.json for its suffix)."),
     model: str = MODEL,
     shots: int | None = SHOTS,
     examples_by: str = EXAMPLES_BY,
