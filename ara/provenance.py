@@ -1,4 +1,5 @@
-"""What every artifact records about what produced it: file hashes, the git commit."""
+"""What every artifact records about what produced it (file hashes, the git commit), and
+how a record is written whole."""
 
 from __future__ import annotations
 
@@ -13,6 +14,16 @@ def cache_root() -> Path:
     """Where converted models, tools and indexes are kept: ``$ARA_CACHE``, else
     ``~/.cache/ara``."""
     return Path(os.environ.get("ARA_CACHE", Path.home() / ".cache" / "ara"))
+
+
+def write_atomic(path: str | Path, text: str) -> None:
+    """Replace ``path`` whole: a kill, or a reader at that moment, sees the old file or
+    the new one, never half of one."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
 
 
 def sha256_file(path: str | Path) -> str:

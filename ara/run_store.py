@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ara.errors import AraError
+from ara.provenance import write_atomic
 
 RUN = "run.json"
 SAMPLES = "samples.jsonl"
@@ -116,9 +117,7 @@ class RunStore:
 
 def _rewrite(path: Path, samples: list[dict]) -> None:
     """Replace the log atomically: an interruption leaves the old one or the new one."""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text("".join(json.dumps(s, sort_keys=True) + "\n" for s in samples))
-    tmp.replace(path)
+    write_atomic(path, "".join(json.dumps(s, sort_keys=True) + "\n" for s in samples))
 
 
 def _check_same_run(old: dict, new: dict, folder: Path, identity: Sequence[str]) -> None:

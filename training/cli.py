@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import user_errors
+from ara.errors import ConfigError
 from ara.training.export import PARITY_PAIRS
 
 model_app = typer.Typer(help="Prepare base models (no downloads).", no_args_is_help=True)
@@ -59,10 +60,14 @@ def train_cmd(
 
     from ara.training.recipe import main
 
-    if status:
-        with user_errors():
-            _print_status(config, as_json)
-        return
+    with user_errors():
+        if as_json and not status:
+            raise ConfigError("--json goes with --status (a run prints its summary as JSON)")
+        if status:
+            if resume:
+                raise ConfigError("--status trains nothing: leave out --resume")
+            _print_status(config, max_steps, as_json)
+            return
 
     # A scheduler, `timeout` or `kill` stops a run with SIGTERM: it now ends as Ctrl-C
     # does, so a recipe records the time the stage took and the log ends on a whole line.
@@ -85,11 +90,10 @@ def train_cmd(
     typer.echo(json.dumps(summary, indent=2))
 
 
-def _print_status(config: Path, as_json: bool) -> None:
+def _print_status(config: Path, max_steps: int | None, as_json: bool) -> None:
     import yaml
 
     from ara.cli_support import emit
-    from ara.errors import ConfigError
     from ara.training.stage_runner import recipe_status
     from ara.training.stages import StagedRecipe, is_staged
 
@@ -99,7 +103,7 @@ def _print_status(config: Path, as_json: bool) -> None:
     if not is_staged(data):
         raise ConfigError(f"{config} is a single run, not a staged recipe: its progress is "
                           "in OUT/train_log.jsonl (a line a step) and OUT/checkpoints/")
-    emit(recipe_status(StagedRecipe.from_dict(data)), as_json, _status_table)
+    emit(recipe_status(StagedRecipe.from_dict(data), max_steps), as_json, _status_table)
 
 
 def _status_table(status: dict) -> str:
@@ -107,17 +111,17 @@ def _status_table(status: dict) -> str:
                               else ""),
              "| stage | kind | steps | state: what a rerun does |", "|---|---|---:|---|"]
     for row in status["stages"]:
-        steps = ("" if row["kind"] != "train" else
-                 f"{row['steps_done']:,} / {row['steps_total'] or '?':,}"
-                 if row["steps_total"] else f"{row['steps_done']:,} / ?")
+        steps = "" if row["kind"] != "train" else f"{row['steps_done']:,} / " + (
+            "?" if row["steps_total"] is None else f"{row['steps_total']:,}")
         lines.append(f"| {row['name']} | {row['kind']} | {steps} | {row['state']} |")
     left = f"{status['steps_left']:,}" + (" or more" if status["steps_left_unknown"] else "")
     pace = status["seconds_per_step"]
-    lines.append("\n" + (f"{left} training steps left: about {status['hours_left']:.1f} h at "
-                          f"{pace:.1f} s a step (the median of the last 200 logged here), "
-                          "besides held-out checks, soups and the export"
-                          if pace else f"{left} training steps left (no step logged yet "
-                          "to time them)"))
+    if pace is None:
+        lines.append(f"\n{left} training steps left (no step logged yet to time them)")
+    else:
+        lines.append(f"\n{left} training steps left: about {status['hours_left']:.1f} h at "
+                     f"{pace:.1f} s a step (the median of the last 200 logged here), besides "
+                     "held-out checks, soups and the export")
     return "\n".join(lines)
 
 

@@ -188,6 +188,13 @@ class TrainConfig:
         if self.init_adapter is not None and not str(self.init_adapter).strip():
             raise ConfigError("init_adapter must be an adapter folder or null, got ''")
 
+    def steps_for(self, examples: int) -> int:
+        """Optimizer steps over ``examples`` training records: micro-batches of
+        ``batch_size`` for ``epochs``, ``grad_accum`` a step, at most ``max_steps``."""
+        optim = self.optim
+        total = -(-examples // optim.batch_size) * optim.epochs // optim.grad_accum
+        return min(total, self.max_steps or total)
+
     @property
     def init_adapter_folder(self) -> Path | None:
         """Where ``init_adapter`` is: a folder, or the shipped adapter's by its name."""

@@ -27,9 +27,9 @@ from pathlib import Path
 from ara.errors import AraError
 from ara.provenance import cache_root, sha256_file
 
-#: llama.cpp quantization types by name (``llama_ftype`` values).
 #: Test pairs the greedy parity check of an export compares by default (0: none).
 PARITY_PAIRS = 20
+#: llama.cpp quantization types by name (``llama_ftype`` values).
 QUANT_TYPES = {"f32": 0, "f16": 1, "q8_0": 7, "q4_k_m": 15, "q5_k_m": 17, "q6_k": 18}
 
 

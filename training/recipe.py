@@ -25,6 +25,7 @@ from tqdm import tqdm
 
 from ara import __version__
 from ara.errors import ConfigError
+from ara.provenance import write_atomic
 from ara.training.config import TrainConfig
 from ara.training.dataset import (
     answer_loss_sum,
@@ -94,8 +95,7 @@ class LoRAFinetuneRecipe:
         # Micro-batches: an optimizer step takes grad_accum of them, across an epoch's
         # end where they do not divide it.
         self.batches_per_epoch = -(-len(self.train_records) // optim.batch_size)
-        total = self.batches_per_epoch * optim.epochs // optim.grad_accum
-        self.total_steps = min(total, self.config.max_steps or total)
+        self.total_steps = self.config.steps_for(len(self.train_records))
         if not self.total_steps:
             raise ConfigError(
                 f"{len(self.train_records)} training records make {self.batches_per_epoch} "
@@ -113,8 +113,9 @@ class LoRAFinetuneRecipe:
             self._load_checkpoint()
         elif self.accelerator.is_main_process:
             self.out.mkdir(parents=True, exist_ok=True)
-            self.out.joinpath("run.json").write_text(json.dumps(self._provenance(), indent=2,
-                                                                sort_keys=True) + "\n")
+            # Whole or not at all: a later rerun and `--status` read it.
+            write_atomic(self.out / "run.json",
+                         json.dumps(self._provenance(), indent=2, sort_keys=True) + "\n")
         self.accelerator.wait_for_everyone()
 
     def _base_model_dir(self) -> str:

@@ -103,16 +103,23 @@ def adapter_identity(folder: str | Path | None) -> dict | None:
     return {"path": str(folder), "sha256": digest}
 
 
-def log_summary(path: Path) -> dict:
-    """The first and last loss and the seconds spent in steps, over every session of the run: a
-    session killed outright records no wall time of its own, but its steps are logged
-    (a step redone after a resume counts again, as the time was spent)."""
+def log_rows(path: Path) -> list[dict]:
+    """The lines of a ``train_log.jsonl`` (none where it is missing), over every session
+    of the run, without the half-written line of a session killed mid-write."""
     rows = []
     for line in path.read_text().splitlines() if path.is_file() else ():
         try:
             rows.append(json.loads(line))
-        except json.JSONDecodeError:  # the half-written line of a session killed mid-write
+        except json.JSONDecodeError:
             continue
+    return rows
+
+
+def log_summary(path: Path) -> dict:
+    """The first and last loss and the seconds spent in steps, over every session of the run: a
+    session killed outright records no wall time of its own, but its steps are logged
+    (a step redone after a resume counts again, as the time was spent)."""
+    rows = log_rows(path)
     return {"first_loss": rows[0]["loss"] if rows else None,
             "last_loss": rows[-1]["loss"] if rows else None,
             "step_seconds": round(sum(r["seconds"] for r in rows), 1)}

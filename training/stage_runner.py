@@ -16,12 +16,14 @@ import shutil
 import statistics
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from ara.errors import ConfigError
+from ara.provenance import write_atomic
 from ara.training.config import TrainConfig
 from ara.training.export import PARITY_PAIRS, export_checked
-from ara.training.run_folder import exclusive, held, whole_checkpoints
+from ara.training.run_folder import exclusive, held, log_rows, whole_checkpoints
 from ara.training.stages import REPLACED, Stage, StagedRecipe
 
 
@@ -36,11 +38,7 @@ def _state(folder: Path) -> dict | None:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    """Replace the file whole: a kill leaves the old one or the new one."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
-    tmp.replace(path)
+    write_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def _write_state(folder: Path, state: dict) -> None:
@@ -109,20 +107,64 @@ def _set_aside(recipe: StagedRecipe, folder: Path) -> Path:
     return dest
 
 
-def _restore(recipe: StagedRecipe, name: str, fingerprint: str, log) -> dict | None:
-    """Bring back the newest folder of stage ``name`` set aside with this very
-    fingerprint (an edit undone, a data version pinned again), done or resumable,
-    setting aside what stands in its place; returns its stage record, else ``None``."""
+def _restore(recipe: StagedRecipe, name: str, old: Path, log) -> None:
+    """Bring back ``old``, a folder of stage ``name`` set aside with the settings asked
+    for now (an edit undone, a data version pinned again), setting aside what stands in
+    its place."""
     folder = recipe.folder(name)
-    found = _set_aside_match(recipe, name, fingerprint)
-    if found is None:
-        return None
-    old, state = found
     kept = _make_room(recipe, folder, "train") if folder.exists() else None
     shutil.move(str(old), str(folder))
     log(f"stage {name}: brought back from {old} (made with these settings)"
         + (f"; the folder in its place is kept as {kept}" if kept else ""))
-    return state
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What a run of the recipe does with one stage, decided from the folders alone
+    (:func:`run_recipe` acts on it, :func:`recipe_status` tells it).
+
+    Attributes:
+        folder: Where the stage's record and checkpoints are: its own folder, or the one
+            set aside in ``replaced/`` that is brought back (``restore``).
+        state: That folder's stage record.
+        done: Skipped: made with these settings from these inputs.
+        resume: Trained on from the newest of ``checkpoints``.
+        waits: Inputs that run first in this run (so the stage runs after them).
+        why: Why its own folder cannot be kept, where it runs again.
+    """
+
+    folder: Path
+    state: dict | None
+    restore: bool
+    done: bool
+    resume: bool
+    checkpoints: tuple[Path, ...]
+    waits: tuple[str, ...]
+    why: str | None
+
+
+def _plan(recipe: StagedRecipe, stage: Stage, fingerprint: str, runs: set[str]) -> _Plan:
+    """``runs``: the stages before this one that this run trains, soups or exports."""
+    own = recipe.folder(stage.name)
+    waits = tuple(name for name in stage.inputs if name in runs)
+    found = (_set_aside_match(recipe, stage.name, fingerprint)
+             if stage.kind == "train" and not waits else None)
+    folder, state = found if found is not None else (own, _state(own))
+    same = bool(state and state.get("fingerprint") == fingerprint and not waits)
+    done = same and bool(state.get("done"))
+    # A training stage killed before its first checkpoint has nothing to resume from.
+    checkpoints = tuple(whole_checkpoints(folder)) if same and stage.kind == "train" else ()
+    resume = not done and bool(checkpoints)
+    why = (_stale(recipe, stage, state, set(waits), same)
+           if not done and not resume and own.exists() else None)
+    return _Plan(folder, state, found is not None, done, resume, checkpoints, waits, why)
+
+
+def _unchecked(recipe: StagedRecipe, stage: Stage, folder: Path) -> bool:
+    """A done training stage trained without the held-out check its config asks for:
+    checks do not change the adapter, so it stays done (on a box without Spot, say)."""
+    return bool(stage.kind == "train" and recipe.train_config(stage).eval_pairs
+                and not (folder / "heldout.json").is_file())
 
 
 def _set_aside_match(recipe: StagedRecipe, name: str,
@@ -139,17 +181,22 @@ def _set_aside_match(recipe: StagedRecipe, name: str,
     return None
 
 
+def _train_config(recipe: StagedRecipe, stage: Stage, max_steps: int | None) -> TrainConfig:
+    """A training stage's run, capped at ``max_steps`` (``--max-steps``) where given."""
+    config = recipe.train_config(stage)
+    if max_steps is None:
+        return config
+    capped = min(config.max_steps or max_steps, max_steps)
+    return TrainConfig.from_dict({**config.to_dict(), "max_steps": capped})
+
+
 def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
                max_steps: int | None) -> dict:
     folder = recipe.folder(stage.name)
     if stage.kind == "train":
         from ara.training.recipe import run_training
 
-        config = recipe.train_config(stage)
-        if max_steps is not None:
-            capped = min(config.max_steps or max_steps, max_steps)
-            config = TrainConfig.from_dict({**config.to_dict(), "max_steps": capped})
-        return run_training(config, resume)
+        return run_training(_train_config(recipe, stage, max_steps), resume)
     if stage.kind == "soup":
         from ara.training.soup import soup_runs
 
@@ -191,39 +238,31 @@ def run_recipe(recipe: StagedRecipe, max_steps: int | None = None, log=print) ->
 
 
 def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
-    prints = recipe.fingerprints()
-    if max_steps is not None:
-        prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}
+    prints = recipe.fingerprints(max_steps)
     record_path = recipe.out / "recipe.json"
     record = json.loads(record_path.read_text()) if record_path.is_file() else {}
     record.setdefault("stages", {})
     ran: set[str] = set()
     for stage in recipe.stages:
-        if stage.kind == "train" and not ran.intersection(stage.inputs):
-            restored = _restore(recipe, stage.name, prints[stage.name], log)
-            if restored is not None and restored.get("done"):
-                record["stages"][stage.name] = {k: v for k, v in restored.items()
+        plan = _plan(recipe, stage, prints[stage.name], ran)
+        folder = recipe.folder(stage.name)
+        if plan.restore:
+            _restore(recipe, stage.name, plan.folder, log)
+            if plan.done:
+                record["stages"][stage.name] = {k: v for k, v in plan.state.items()
                                                 if k != "done"}
                 _write_json(record_path, record)
-        folder, state = recipe.folder(stage.name), _state(recipe.folder(stage.name))
-        same = bool(state and state.get("fingerprint") == prints[stage.name]
-                    and not ran.intersection(stage.inputs))
-        if same and state.get("done"):
-            # Held-out checks do not change the adapter, so a stage trained without one
-            # (on a box without Spot) stays done; say so rather than leave it unnoticed.
-            unchecked = (stage.kind == "train" and recipe.train_config(stage).eval_pairs
-                         and not (folder / "heldout.json").is_file())
+        state, resume = plan.state, plan.resume
+        if plan.done:
             log(f"stage {stage.name}: done, skipped"
-                + (" (trained without the held-out check)" if unchecked else ""))
+                + (" (trained without the held-out check)"
+                   if _unchecked(recipe, stage, folder) else ""))
             continue
-        # A training stage killed before its first checkpoint has nothing to resume from.
-        resume = same and stage.kind == "train" and bool(whole_checkpoints(folder))
-        if folder.exists() and not resume:
+        if plan.why is not None:
             # Made with other settings or from other inputs (it would mix two recipes), or
             # cut short before anything in it could be resumed.
-            why = _stale(recipe, stage, state, ran, same)
             kept = _make_room(recipe, folder, stage.kind)
-            log(f"stage {stage.name}: {why}; rebuilding it"
+            log(f"stage {stage.name}: {plan.why}; rebuilding it"
                 + (f" (the old folder is kept as {kept}; delete it once unneeded)" if kept
                    else ""))
             record["stages"].pop(stage.name, None)
@@ -254,58 +293,56 @@ def _run_recipe(recipe: StagedRecipe, max_steps: int | None, log) -> dict:
     return record
 
 
-def recipe_status(recipe: StagedRecipe) -> dict:
+def recipe_status(recipe: StagedRecipe, max_steps: int | None = None) -> dict:
     """Where a recipe stands, read from its folder without changing anything: what a
-    rerun would do with each stage (skip it, resume it from a checkpoint, bring it back
-    from ``replaced/``, or run it, and why), each training stage's steps, and the
+    rerun (with ``max_steps``, as ``--max-steps``) would do with each stage, by the
+    rules it would follow (:func:`_plan`), each training stage's steps, and the
     training steps left at the pace its logs show."""
-    prints = recipe.fingerprints()
+    prints = recipe.fingerprints(max_steps)
     running = held(recipe.out)
-    pending: set[str] = set()  # stages a rerun runs: whatever reads them runs again
+    runs: set[str] = set()  # the stages a rerun would run
     rows, seconds = [], []
     for stage in recipe.stages:
-        folder = recipe.folder(stage.name)
-        state = _state(folder)
-        waits = [name for name in stage.inputs if name in pending]
-        same = bool(state and state.get("fingerprint") == prints[stage.name] and not waits)
-        found = (_set_aside_match(recipe, stage.name, prints[stage.name])
-                 if stage.kind == "train" and not waits else None)
-        if found is not None:
-            folder, state, same = found[0], found[1], True
-        checkpoints = whole_checkpoints(folder) if same and stage.kind == "train" else []
-        kept = int(checkpoints[-1].name.split("_")[1]) if checkpoints else 0
-        done = same and bool(state.get("done"))
-        if done:
-            says = "done"
-        elif checkpoints:
-            says = (f"training now (checkpoint at step {kept})" if running and not pending
-                    else f"resumes from step {kept}")
-        elif waits:
-            says = f"runs {'again ' if folder.exists() else ''}after {', '.join(waits)}"
-        elif folder.exists():
-            says = f"runs again: {_stale(recipe, stage, state, pending, same)}"
+        plan = _plan(recipe, stage, prints[stage.name], runs)
+        kept = int(plan.checkpoints[-1].name.split("_")[1]) if plan.checkpoints else 0
+        # The run holding the folder is at the first stage not done (if it runs these
+        # settings: a config edited since would show the stage as stale).
+        live = (running and not plan.done and not runs
+                and (plan.state or {}).get("fingerprint") == prints[stage.name])
+        if plan.done:
+            says = "done" + (" (trained without the held-out check)"
+                             if _unchecked(recipe, stage, plan.folder) else "")
+        elif live:
+            says = "running now" + (f" (checkpoint at step {kept})" if plan.resume else "")
+        elif plan.resume:
+            says = f"resumes from step {kept}"
+        elif plan.waits:
+            says = (f"runs {'again ' if recipe.folder(stage.name).exists() else ''}after "
+                    f"{', '.join(plan.waits)}")
+        elif plan.why:
+            says = f"runs again: {plan.why}"
         else:
             says = "to run"
-        if found is not None:
-            says += f" (brought back from {found[0].name})"
+        if plan.restore:
+            says += f" (brought back from {plan.folder.name})"
         row = {"name": stage.name, "kind": stage.kind, "state": says, "steps_done": None,
                "steps_total": None, "steps_left": None}
         if stage.kind == "train":
-            config = recipe.train_config(stage)
-            total = _total_steps(folder / "run.json", config) if same else config.max_steps
-            log = folder / "train_log.jsonl"
-            logged = [json.loads(line) for line in log.read_text().splitlines()
-                      if line.endswith("}")] if same and log.is_file() else []
+            config = _train_config(recipe, stage, max_steps)
+            mine = plan.done or plan.resume or live  # its folder is this stage's
+            total = _total_steps(plan.folder / "run.json", config) if mine else (
+                config.max_steps)
+            logged = log_rows(plan.folder / "train_log.jsonl") if mine else []
             seconds += [r["seconds"] for r in logged]
             # Steps kept: the newest checkpoint's (a rerun redoes those after it), or,
             # while this stage trains, the steps logged so far.
-            steps = total if done else kept
-            if running and not pending and logged:
+            steps = total if plan.done else kept
+            if live and logged:
                 steps = max(steps, logged[-1]["step"])
             row.update(steps_done=steps, steps_total=total,
                        steps_left=None if total is None else total - steps)
-        if not done:
-            pending.add(stage.name)
+        if not plan.done:
+            runs.add(stage.name)
         rows.append(row)
     pace = statistics.median(seconds[-200:]) if seconds else None
     left = [r["steps_left"] for r in rows if r["kind"] == "train"]
@@ -317,10 +354,10 @@ def recipe_status(recipe: StagedRecipe) -> dict:
 
 
 def _total_steps(run_json: Path, config: TrainConfig) -> int | None:
-    """A started run's steps, from the training records its ``run.json`` counted."""
-    if not run_json.is_file():
+    """A started run's steps, from the training records its ``run.json`` counted
+    (``max_steps`` alone where it has none yet)."""
+    try:
+        examples = json.loads(run_json.read_text())["data"]["train_examples"]
+    except (OSError, ValueError, KeyError):
         return config.max_steps
-    examples = json.loads(run_json.read_text())["data"]["train_examples"]
-    optim = config.optim
-    total = -(-examples // optim.batch_size) * optim.epochs // optim.grad_accum
-    return min(total, config.max_steps or total)
+    return config.steps_for(examples)

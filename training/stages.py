@@ -128,8 +128,10 @@ class StagedRecipe:
             merged["init_adapter"] = str(self.folder(stage.inputs[0]) / "adapter")
         return TrainConfig.from_dict(merged)
 
-    def fingerprints(self) -> dict[str, str]:
-        """Each stage's identity: its kind, settings and its inputs' fingerprints."""
+    def fingerprints(self, max_steps: int | None = None) -> dict[str, str]:
+        """Each stage's identity: its kind, settings and its inputs' fingerprints;
+        ``max_steps``, a smoke run's cap on every training stage (``--max-steps``),
+        makes each stage another one."""
         prints: dict[str, str] = {}
         for stage in self.stages:
             settings = stage.settings
@@ -154,6 +156,8 @@ class StagedRecipe:
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)
             prints[stage.name] = hashlib.sha256(blob.encode()).hexdigest()[:16]
+        if max_steps is not None:
+            prints = {k: f"{v}-max{max_steps}" for k, v in prints.items()}
         return prints
 
 

@@ -162,6 +162,61 @@ def test_one_recipe_at_a_time_trains_in_a_folder(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == [".lock"]
 
 
+def test_status_tells_what_a_rerun_would_do_and_touches_nothing(tmp_path):
+    """Tests `ara train --config RECIPE --status` on stage folders written as a run leaves
+    them: a stage a live run holds, the same stage once that run is gone (killed before
+    its first checkpoint, then after one), and the table and JSON the command prints."""
+    from typer.testing import CliRunner
+
+    from ara.cli import app
+    from ara.training.run_folder import exclusive, held
+
+    out = tmp_path / "out"
+    data = {"out": str(out), "stages": [
+        {"name": "a", "train": {"max_steps": 40, "optim": {"grad_accum": 2}}},
+        {"name": "b", "from": "a", "train": {"max_steps": 10}},
+        {"name": "s", "soup": ["b"], "rank": 4}]}
+    recipe = StagedRecipe.from_dict(data)
+    fresh = recipe_status(recipe)
+    assert [(r["state"], r["steps_total"]) for r in fresh["stages"]] == [
+        ("to run", 40), ("runs after a", 10), ("runs after b", None)]
+    assert fresh["seconds_per_step"] is None and not out.exists()  # read, nothing made
+
+    a = out / "a"
+    a.mkdir(parents=True)
+    (a / "stage.json").write_text(json.dumps({"name": "a", "kind": "train", "done": False,
+                                              "fingerprint": recipe.fingerprints()["a"]}))
+    # 100 records in micro-batches of 8, two a step: 6 steps, under max_steps.
+    (a / "run.json").write_text(json.dumps({"data": {
+        "train_examples": 100, "version": registered_version("paper", 0)}}))
+    (a / "train_log.jsonl").write_text("".join(
+        json.dumps({"step": n, "seconds": 2.0}) + "\n" for n in (1, 2, 3)) + '{"step": 4, "se')
+    with exclusive(out):
+        assert held(out)
+        live = recipe_status(recipe)
+    assert live["running"] and live["stages"][0] == {
+        "name": "a", "kind": "train", "state": "running now", "steps_done": 3,
+        "steps_total": 6, "steps_left": 3}
+    assert live["seconds_per_step"] == 2.0 and live["hours_left"] == round(13 * 2 / 3600, 2)
+
+    assert not held(out)
+    gone = recipe_status(recipe)["stages"][0]
+    assert (gone["state"], gone["steps_done"]) == (
+        "runs again: it stopped before its first checkpoint", 0)
+    (a / "checkpoints" / "step_2").mkdir(parents=True)
+    (a / "checkpoints" / "step_2" / "step.json").write_text("{}")
+    config = tmp_path / "recipe.yaml"
+    config.write_text(yaml.safe_dump(data))
+    table = CliRunner().invoke(app, ["train", "--config", str(config), "--status"])
+    assert table.exit_code == 0 and "| a | train | 2 / 6 | resumes from step 2 |" in table.output
+    as_json = CliRunner().invoke(app, ["train", "--config", str(config), "--status", "--json"])
+    assert json.loads(as_json.output)["steps_left"] == 4 + 10
+    smoke = CliRunner().invoke(app, ["train", "--config", str(config), "--status",
+                                     "--max-steps", "3"])  # another run: a starts over
+    assert "| a | train | 0 / 3 | runs again: its settings changed |" in smoke.output
+    assert sorted(p.name for p in out.iterdir()) == [".lock", "a"]
+
+
 def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
         tiny_gemma_dir, paper_split, tmp_path):
     """Tests the runner end to end on a tiny Gemma 3: interrupted between stages, a rerun
@@ -212,6 +267,7 @@ def test_one_command_runs_every_stage_and_a_rerun_goes_on_where_it_stopped(
     # A stage killed before its first checkpoint (its run.json written) starts again.
     state = json.loads((out / "refine-b" / "stage.json").read_text())
     (out / "refine-b" / "stage.json").write_text(json.dumps({**state, "done": False}))
+    assert recipe_status(recipe)["stages"][2]["state"] == "resumes from step 1"
     for part in ("checkpoints", "adapter"):
         shutil.rmtree(out / "refine-b" / part)
     assert [r["state"] for r in recipe_status(recipe)["stages"]][2:] == [
