@@ -128,8 +128,6 @@ def warm_started(base, folder: str, lora):
     from peft import LoraConfig, PeftModel
 
     saved = LoraConfig.from_pretrained(folder)
-    saved.lora_dropout = lora.dropout
-    model = PeftModel.from_pretrained(base, folder, is_trainable=True, config=saved)
     checks = [("r", saved.r, lora.r), ("alpha", saved.lora_alpha, lora.alpha)]
     # A saved adapter lists the modules "all-linear" resolved to, so only an explicit
     # list in the config can be compared with it.
@@ -141,4 +139,5 @@ def warm_started(base, folder: str, lora):
         detail = ", ".join(f"{k}: adapter {g} vs config {w}" for k, (g, w) in mismatched.items())
         raise ConfigError(f"init_adapter {folder} has another LoRA shape ({detail}); "
                           "set lora to the adapter's values")
-    return model
+    saved.lora_dropout = lora.dropout
+    return PeftModel.from_pretrained(base, folder, is_trainable=True, config=saved)

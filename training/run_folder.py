@@ -7,6 +7,7 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -27,11 +28,17 @@ def exclusive(out: Path) -> Iterator[None]:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     with open(out / ".lock", "w") as handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise ConfigError(f"another ara train is running on {out}: wait for it, or stop "
-                              "it first") from None
+        # `--status` holds the lock for an instant to see whether a run holds it: a run
+        # starting in that instant tries again rather than refuse.
+        for attempt in range(5):
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if attempt == 4:
+                    raise ConfigError(f"another ara train is running on {out}: wait for it, "
+                                      "or stop it first") from None
+                time.sleep(0.1)
         yield
 
 
