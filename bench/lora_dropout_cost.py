@@ -70,9 +70,10 @@ def main() -> None:
     rows = [run("recipe", None, args.steps, args.out),
             run(f"dropout-{args.dropout}", args.dropout, args.steps, args.out)]
     mine, other = rows
+    pairs = list(zip(mine["losses"], other["losses"], strict=True))
     result = {"rows": rows,
               "recipe_speed_ratio": other["median_s_per_step"] / mine["median_s_per_step"],
-              "max_loss_gap": max(abs(a - b) for a, b in zip(mine["losses"], other["losses"])),
+              "max_loss_gap": max(abs(a - b) for a, b in pairs),
               "torch": torch.__version__, "threads": torch.get_num_threads(),
               "date": time.strftime("%Y-%m-%d", time.gmtime())}
     args.out.mkdir(parents=True, exist_ok=True)
@@ -83,7 +84,7 @@ def main() -> None:
               f"| {r['wall_s']} |")
     print(f"\nthe recipe's step takes {1 / result['recipe_speed_ratio']:.2f}x the time of one "
           f"with dropout {args.dropout}; losses step by step:")
-    for i, (a, b) in enumerate(zip(mine["losses"], other["losses"]), start=1):
+    for i, (a, b) in enumerate(pairs, start=1):
         print(f"  step {i:3d}  recipe {a:.4f}  dropout {args.dropout} {b:.4f}  "
               f"gap {abs(a - b):.4f}")
 
