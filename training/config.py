@@ -31,6 +31,8 @@ SHIPPED_PEFT = {"finetuned": SHIPPED / "gemma3-270m-nl2tl-lora-peft"}
 #: Run settings that leave the adapter as it is: how often a run checkpoints, how many
 #: checkpoints it keeps, and the held-out check at its end. A resumed run may change
 #: them, and a recipe stage's identity leaves them out.
+#: ``precision`` values (``auto`` picks by machine: :func:`hf_model.training_dtype`).
+PRECISIONS = ("auto", "bf16", "fp32")
 BOOKKEEPING = frozenset({"eval_pairs", "checkpoint_every", "keep_checkpoints"})
 
 
@@ -164,6 +166,12 @@ class TrainConfig:
             the whole model state (about 1 GB for the 270M), so keeping all of them
             fills a disk over a few runs.
         eval_pairs: Test pairs for the held-out check at the end (0: none).
+        precision: What the frozen base model computes in: ``bf16``, ``fp32``, or
+            ``auto`` (default): bf16 where the hardware runs it natively (a GPU that has
+            it; a CPU with AMX, Intel Xeon since Sapphire Rapids), fp32 elsewhere (a CPU
+            without AMX emulates bf16, slowly). The LoRA weights, the optimizer and the
+            loss stay fp32. ``run.json`` records what it was when the run began; a
+            resumed run may go on in another (on another machine).
         lora, optim, data: Sub-configs (see each).
     """
 
@@ -175,6 +183,7 @@ class TrainConfig:
     checkpoint_every: int = 100
     keep_checkpoints: int = 2
     eval_pairs: int = 100
+    precision: str = "auto"
     lora: LoraSettings = field(default_factory=LoraSettings)
     optim: OptimSettings = field(default_factory=OptimSettings)
     data: DataSettings = field(default_factory=DataSettings)
@@ -185,6 +194,9 @@ class TrainConfig:
         if self.checkpoint_every < 1 or self.eval_pairs < 0 or self.keep_checkpoints < 1:
             raise ConfigError("checkpoint_every and keep_checkpoints must be >= 1, "
                               "eval_pairs >= 0")
+        if self.precision not in PRECISIONS:
+            raise ConfigError(f"precision must be one of {', '.join(PRECISIONS)}, "
+                              f"got {self.precision!r}")
         if self.init_adapter is not None and not str(self.init_adapter).strip():
             raise ConfigError("init_adapter must be an adapter folder or null, got ''")
 

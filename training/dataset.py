@@ -161,22 +161,26 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
     picked = torch.searchsorted(keep, cols)
     ids, mask = batch["input_ids"], batch["attention_mask"]
     shared = min(shared_prefix_length(batch), int(keep.min())) if share_prefix else 0
-    if shared < 2 or ids.shape[0] == 1:
-        inputs = {"input_ids": ids, "attention_mask": mask, "logits_to_keep": keep}
-    else:
-        prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
-        cache = cache_of(prefix)
-        cache.batch_repeat_interleave(ids.shape[0])
-        inputs = {"input_ids": ids[:, shared:], "attention_mask": mask,
-                  **with_cache(cache), "logits_to_keep": keep - shared}
+    # The hidden states the output layer gets, two-dimensional: a (1, tokens, hidden)
+    # input takes a batched product, which in bf16 on a CPU first copies the whole
+    # transposed 262k-row layer (more than a third of a step).
+    pick = [lambda h: h[0, :0]]  # the prefix's keys and values are wanted, no logit
     head = getattr(model, "module", model).get_output_embeddings()
-    hook = head.register_forward_pre_hook(
-        lambda _, args: (args[0][rows, picked].unsqueeze(0), *args[1:]))
+    hook = head.register_forward_pre_hook(lambda _, args: (pick[-1](args[0]), *args[1:]))
     try:
+        if shared < 2 or ids.shape[0] == 1:
+            inputs = {"input_ids": ids, "attention_mask": mask, "logits_to_keep": keep}
+        else:
+            prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
+            cache = cache_of(prefix)
+            cache.batch_repeat_interleave(ids.shape[0])
+            inputs = {"input_ids": ids[:, shared:], "attention_mask": mask,
+                      **with_cache(cache), "logits_to_keep": keep - shared}
+        pick.append(lambda h: h[rows, picked])
         out = model(**inputs)
     finally:
         hook.remove()
-    logits = out.logits[0]  # (answer tokens, vocab)
+    logits = out.logits.reshape(-1, out.logits.shape[-1])  # (answer tokens, vocab)
     total = torch.nn.functional.cross_entropy(logits.float(), gathered, reduction="sum")
     return total, int(gathered.numel())
 

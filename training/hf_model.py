@@ -29,6 +29,39 @@ class ModelPrepError(AraError, RuntimeError):
     """The base model could not be converted or found."""
 
 
+def training_dtype(precision: str, device):
+    """The torch dtype the frozen base model computes in on ``device`` (see
+    ``TrainConfig.precision``)."""
+    import torch
+
+    if precision == "auto":
+        if device.type == "cuda":
+            native = torch.cuda.is_bf16_supported()
+        else:
+            # AMX multiplies bf16 natively; without it bf16 is converted and loses to fp32.
+            native = device.type == "cpu" and getattr(
+                torch.cpu, "_is_amx_tile_supported", lambda: False)()
+        precision = "bf16" if native else "fp32"
+    return torch.bfloat16 if precision == "bf16" else torch.float32
+
+
+def forward_in(dtype, model, device):
+    """Where the base is bf16, the training forward runs under autocast: the fp32 LoRA
+    layers take their bf16 inputs as they are and multiply in bf16 (peft would copy
+    each input to fp32 first, which took the gain away on a CPU), and the loss comes
+    back in fp32. Elsewhere, and outside it (generation), nothing changes."""
+    from contextlib import ExitStack
+
+    import torch
+    from peft.helpers import disable_input_dtype_casting
+
+    stack = ExitStack()
+    if dtype == torch.bfloat16:
+        stack.enter_context(torch.autocast(device.type, dtype=torch.bfloat16))
+        stack.enter_context(disable_input_dtype_casting(model))
+    return stack
+
+
 def default_hf_dir() -> Path:
     return cache_root() / "models" / "gemma-3-270m-hf"
 

@@ -37,7 +37,7 @@ from ara.training.dataset import (
     repeat_sources,
     shot_rng,
 )
-from ara.training.hf_model import load_tokenizer, warm_started
+from ara.training.hf_model import forward_in, load_tokenizer, training_dtype, warm_started
 from ara.training.run_folder import (
     adapter_identity,
     exclusive,
@@ -85,6 +85,7 @@ class LoRAFinetuneRecipe:
                                        step_scheduler_with_optimizer=False)
         set_seed(self.config.seed)
         self.model_dir = self._base_model_dir()
+        self.dtype = training_dtype(self.config.precision, self.accelerator.device)
         # The tokenizer before the data (examples are token ids), the data before the
         # schedule (its length sets the number of steps).
         self.tokenizer = load_tokenizer(self.model_dir)
@@ -152,7 +153,7 @@ class LoRAFinetuneRecipe:
         from peft import LoraConfig, get_peft_model
         from transformers import AutoModelForCausalLM
 
-        dtype = torch.float32 if self.accelerator.device.type == "cpu" else torch.bfloat16
+        dtype = self.dtype
         base = AutoModelForCausalLM.from_pretrained(self.model_dir, local_files_only=True,
                                                     dtype=dtype)
         lora = self.config.lora
@@ -182,6 +183,7 @@ class LoRAFinetuneRecipe:
                             if self.config.data.pairs else {})},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "processes": self.accelerator.num_processes,
+                "dtype": str(self.dtype).removeprefix("torch."),
                 "init_adapter": adapter_identity(self.config.init_adapter_folder),
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
@@ -223,7 +225,8 @@ class LoRAFinetuneRecipe:
                     examples = encode(mine or micro[:1], self.tokenizer, shots)
                     batch = {k: v.to(acc.device) for k, v in collate(examples, pad).items()}
                     with acc.accumulate(self.model):
-                        total, count = answer_loss_sum(self.model, batch)
+                        with forward_in(self.dtype, self.model, acc.device):
+                            total, count = answer_loss_sum(self.model, batch)
                         # One exchange per micro-batch: the batch's loss sum, its answer
                         # tokens and all its tokens, over every process.
                         loss_sum, counted, batch_tokens = acc.reduce(weight * torch.stack([

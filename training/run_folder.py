@@ -65,8 +65,9 @@ def whole_checkpoints(out: Path) -> list[Path]:
 
 
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),
-#: and those that leave the adapter as it is.
-RESUMABLE_KEYS = BOOKKEEPING | {"max_steps"}
+#: the precision it computes in (a run may go on on another machine, as a run begun on
+#: a GPU goes on on a CPU), and those that leave the adapter as it is.
+RESUMABLE_KEYS = BOOKKEEPING | {"max_steps", "precision"}
 
 
 def refuse_changed_config(run_json: Path, config: TrainConfig) -> None:

@@ -29,6 +29,7 @@ def build_tiny_gemma(folder: str | Path, tokenizer_dir: str | Path, seed: int = 
 
 #: The run the golden losses come from (``scripts/golden_losses.py``).
 GOLDEN_RUN = {"seed": 0, "checkpoint_every": 100, "eval_pairs": 0, "max_steps": 2,
+              "precision": "fp32",  # the same losses on every machine
               "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
               "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0},
               "data": {"forms": ["lifted"], "limit": 8}}

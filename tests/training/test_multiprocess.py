@@ -41,6 +41,7 @@ def test_two_processes_train_like_one_with_the_same_global_batch(tiny_gemma_dir,
     of 4, log one line per step, and their losses equal a single process's on the
     whole batch, step after step."""
     config = {"base_model": tiny_gemma_dir, "seed": 0, "checkpoint_every": 100,
+              "precision": "fp32",
               "eval_pairs": 0, "max_steps": 3,
               "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
               "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0, "epochs": 2},

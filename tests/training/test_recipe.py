@@ -12,8 +12,10 @@ from ara.training.recipe import LoRAFinetuneRecipe, run_training
 
 
 def tiny_config(model_dir, out, **overrides):
+    # fp32 everywhere: "auto" would take bf16 on a CPU with AMX, and equalities of losses
+    # across runs need one precision on every machine.
     base = {"base_model": model_dir, "out": str(out), "seed": 0, "checkpoint_every": 3,
-            "eval_pairs": 0, "max_steps": 6,
+            "eval_pairs": 0, "max_steps": 6, "precision": "fp32",
             "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
             "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0},
             "data": {"forms": ["lifted"], "limit": 8}}
@@ -151,6 +153,29 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
     report = recipe.heldout_check()
     assert report["pairs"] == 2 and set(report["by_shots"]) == {"0", "2"}
     assert report["validity"] == 1.0
+
+
+def test_a_bf16_run_keeps_its_adapter_and_loss_in_fp32(tiny_gemma_dir, tmp_path):
+    """Tests ``precision: bf16``: the frozen base in bf16, the LoRA weights (what is
+    trained and saved) in fp32, a loss that starts where fp32's does and falls, and the
+    held-out check generating from it (outside the training forward's autocast)."""
+    import torch
+
+    runs = {}
+    for precision in ("fp32", "bf16"):
+        config = tiny_config(tiny_gemma_dir, tmp_path / precision, max_steps=3,
+                             precision=precision, eval_pairs=1)
+        recipe = LoRAFinetuneRecipe(config)
+        recipe.setup()
+        runs[precision] = (recipe, recipe.train())
+    bf16, losses = runs["bf16"]
+    assert {p.dtype for p in bf16.model.parameters() if p.requires_grad} == {torch.float32}
+    assert {p.dtype for p in bf16.model.parameters() if not p.requires_grad} == {torch.bfloat16}
+    assert json.loads((tmp_path / "bf16" / "run.json").read_text())["dtype"] == "bfloat16"
+    # The first step is the base model's (a fresh LoRA adds nothing): bf16 rounding only.
+    assert losses[0] == pytest.approx(runs["fp32"][1][0], rel=2e-2)
+    assert losses[-1] < losses[0]
+    assert bf16.heldout_check()["validity"] == 1.0
 
 
 @pytest.mark.slow  # the default tier warm-starts a stage in test_stage_runner

@@ -23,6 +23,7 @@ def tiny_recipe(model_dir, out, refine_b_seed=2) -> dict:
     return {
         "out": str(out),
         "defaults": {"base_model": model_dir, "seed": 0, "checkpoint_every": 1,
+                     "precision": "fp32",
                      "keep_checkpoints": 1, "eval_pairs": 0,
                      "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
                      "optim": {"lr": 5e-3, "batch_size": 4, "warmup_steps": 0},
