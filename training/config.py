@@ -28,11 +28,11 @@ def _build(cls, data: dict | None, where: str):
 #: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
 #: by ``--model`` name, beside their GGUF.
 SHIPPED_PEFT = {"finetuned": SHIPPED / "gemma3-270m-nl2tl-lora-peft"}
+#: ``precision`` values (``auto`` picks by machine: :func:`hf_model.training_dtype`).
+PRECISIONS = ("auto", "bf16", "fp32")
 #: Run settings that leave the adapter as it is: how often a run checkpoints, how many
 #: checkpoints it keeps, and the held-out check at its end. A resumed run may change
 #: them, and a recipe stage's identity leaves them out.
-#: ``precision`` values (``auto`` picks by machine: :func:`hf_model.training_dtype`).
-PRECISIONS = ("auto", "bf16", "fp32")
 BOOKKEEPING = frozenset({"eval_pairs", "checkpoint_every", "keep_checkpoints"})
 
 
@@ -167,11 +167,12 @@ class TrainConfig:
             fills a disk over a few runs.
         eval_pairs: Test pairs for the held-out check at the end (0: none).
         precision: What the frozen base model computes in: ``bf16``, ``fp32``, or
-            ``auto`` (default): bf16 where the hardware runs it natively (a GPU that has
-            it; a CPU with AMX, Intel Xeon since Sapphire Rapids), fp32 elsewhere (a CPU
-            without AMX emulates bf16, slowly). The LoRA weights, the optimizer and the
-            loss stay fp32. ``run.json`` records what it was when the run began; a
-            resumed run may go on in another (on another machine).
+            ``auto`` (default): bf16 where the hardware multiplies it natively (a CUDA
+            GPU since Ampere; a CPU with AMX, Intel Xeon since Sapphire Rapids), fp32
+            elsewhere (without them bf16 is emulated, slowly). The LoRA weights and the
+            optimizer stay fp32, and the loss is taken in fp32. It is no part of what a
+            run trains (a recipe stage's identity leaves it out): a resumed run may go on
+            in another, on another machine; each log line records the one of its step.
         lora, optim, data: Sub-configs (see each).
     """
 

@@ -36,7 +36,7 @@ def training_dtype(precision: str, device):
 
     if precision == "auto":
         if device.type == "cuda":
-            native = torch.cuda.is_bf16_supported()
+            native = torch.cuda.is_bf16_supported(including_emulation=False)
         else:
             # AMX multiplies bf16 natively; without it bf16 is converted and loses to fp32.
             native = device.type == "cpu" and getattr(
@@ -48,8 +48,9 @@ def training_dtype(precision: str, device):
 def forward_in(dtype, model, device):
     """Where the base is bf16, the training forward runs under autocast: the fp32 LoRA
     layers take their bf16 inputs as they are and multiply in bf16 (peft would copy
-    each input to fp32 first, which took the gain away on a CPU), and the loss comes
-    back in fp32. Elsewhere, and outside it (generation), nothing changes."""
+    each input to fp32 first, which took the gain away on a CPU). Outside it (the
+    held-out check's generation) peft's copies stay: the LoRA part in fp32, added back
+    in bf16."""
     from contextlib import ExitStack
 
     import torch

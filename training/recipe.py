@@ -86,6 +86,7 @@ class LoRAFinetuneRecipe:
         set_seed(self.config.seed)
         self.model_dir = self._base_model_dir()
         self.dtype = training_dtype(self.config.precision, self.accelerator.device)
+        self.dtype_name = str(self.dtype).removeprefix("torch.")
         # The tokenizer before the data (examples are token ids), the data before the
         # schedule (its length sets the number of steps).
         self.tokenizer = load_tokenizer(self.model_dir)
@@ -183,7 +184,7 @@ class LoRAFinetuneRecipe:
                             if self.config.data.pairs else {})},
                 "base_model": {"path": self.model_dir, "gguf_sha256": base_hash},
                 "processes": self.accelerator.num_processes,
-                "dtype": str(self.dtype).removeprefix("torch."),
+                "dtype": self.dtype_name,
                 "init_adapter": adapter_identity(self.config.init_adapter_folder),
                 "trainable_parameters": sum(p.numel() for p in self.model.parameters()
                                             if p.requires_grad)}
@@ -254,7 +255,8 @@ class LoRAFinetuneRecipe:
                                               "shots": (micro_shots[0] if len(micro_shots) == 1
                                                         else micro_shots),
                                               "tokens_per_s": round(rate, 1),
-                                              "seconds": round(seconds, 2)}) + "\n")
+                                              "seconds": round(seconds, 2),
+                                              "dtype": self.dtype_name}) + "\n")
                         log.flush()
                     micro_losses, micro_shots, tokens = [], [], 0
                     bar.set_postfix(loss=f"{losses[-1]:.3f}", tok_s=f"{rate:.0f}", refresh=False)

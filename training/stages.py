@@ -139,10 +139,10 @@ class StagedRecipe:
                 # A stage trained with the held-out check off (say, on a GPU box without
                 # Spot) counts as done where the check is on.
                 config = self.train_config(stage)
-                settings = {k: v for k, v in config.to_dict().items() if k not in BOOKKEEPING}
-                # Only where set: recipes from before the setting keep their fingerprints.
-                if settings["precision"] == "auto":
-                    del settings["precision"]
+                # Precision is how a machine computes the run, as a resumed run may
+                # change it: not what the stage is.
+                settings = {k: v for k, v in config.to_dict().items()
+                            if k not in BOOKKEEPING and k != "precision"}
                 # "The version this release registers" names other data once a release
                 # registers another: a stage trained on the old one is stale.
                 settings["data"] = {**settings["data"],

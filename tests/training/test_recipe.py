@@ -172,6 +172,8 @@ def test_a_bf16_run_keeps_its_adapter_and_loss_in_fp32(tiny_gemma_dir, tmp_path)
     assert {p.dtype for p in bf16.model.parameters() if p.requires_grad} == {torch.float32}
     assert {p.dtype for p in bf16.model.parameters() if not p.requires_grad} == {torch.bfloat16}
     assert json.loads((tmp_path / "bf16" / "run.json").read_text())["dtype"] == "bfloat16"
+    log = (tmp_path / "bf16" / "train_log.jsonl").read_text().splitlines()
+    assert {json.loads(line)["dtype"] for line in log} == {"bfloat16"}
     # The first step is the base model's (a fresh LoRA adds nothing): bf16 rounding only.
     assert losses[0] == pytest.approx(runs["fp32"][1][0], rel=2e-2)
     assert losses[-1] < losses[0]

@@ -70,6 +70,17 @@ def test_a_stage_is_what_makes_its_adapter_so_bookkeeping_and_later_stages_leave
                                       prints.values(), strict=True))
 
 
+def test_precision_is_how_a_stage_is_computed_not_what_it_is():
+    """A recipe moved to a machine with other arithmetic (or told bf16 where auto already
+    meant it) keeps its stages: only their settings and inputs make them."""
+    data = {"out": "runs/x", "stages": [{"name": "a", "train": {}},
+                                        {"name": "b", "from": "a", "train": {}}]}
+    prints = {precision: StagedRecipe.from_dict({**data, "defaults": {"precision": precision}})
+              .fingerprints() for precision in ("auto", "bf16", "fp32")}
+    assert prints["auto"] == prints["bf16"] == prints["fp32"] == StagedRecipe.from_dict(
+        data).fingerprints()
+
+
 def test_a_stage_trained_on_the_registered_data_is_stale_once_another_version_is_registered():
     """Tests that `version: null` counts as the version this release registers: pinning
     that very version leaves every stage done, and any other version (what a release that
