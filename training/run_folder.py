@@ -56,12 +56,16 @@ def held(out: Path) -> bool:
         return False
 
 
+def checkpoint_step(checkpoint: Path) -> int:
+    """The step a checkpoint folder (``checkpoints/step_N``) was saved at."""
+    return int(checkpoint.name.removeprefix("step_"))
+
+
 def whole_checkpoints(out: Path) -> list[Path]:
     """The whole checkpoints of run folder ``out`` (``step.json`` is written last, so a
     checkpoint a kill cut short has none), oldest first."""
     return sorted((p for p in (out / "checkpoints").glob("step_*")
-                   if p.joinpath("step.json").is_file()),
-                  key=lambda p: int(p.name.split("_")[1]))
+                   if p.joinpath("step.json").is_file()), key=checkpoint_step)
 
 
 #: Settings a resumed run may change: how long it runs (``--max-steps`` extends a run),

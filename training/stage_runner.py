@@ -23,7 +23,8 @@ from ara.errors import ConfigError
 from ara.provenance import write_atomic
 from ara.training.config import TrainConfig
 from ara.training.export import PARITY_PAIRS, export_checked
-from ara.training.run_folder import exclusive, held, log_rows, whole_checkpoints
+from ara.training.run_folder import (checkpoint_step, exclusive, held, log_rows,
+                                     whole_checkpoints)
 from ara.training.stages import REPLACED, Stage, StagedRecipe
 
 
@@ -304,7 +305,7 @@ def recipe_status(recipe: StagedRecipe, max_steps: int | None = None) -> dict:
     rows, seconds = [], []
     for stage in recipe.stages:
         plan = _plan(recipe, stage, prints[stage.name], runs)
-        kept = int(plan.checkpoints[-1].name.split("_")[1]) if plan.checkpoints else 0
+        kept = checkpoint_step(plan.checkpoints[-1]) if plan.checkpoints else 0
         # The run holding the folder is at the first stage not done (if it runs these
         # settings: a config edited since would show the stage as stale).
         live = (running and not plan.done and not runs
