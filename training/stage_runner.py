@@ -23,8 +23,7 @@ from ara.errors import ConfigError
 from ara.provenance import write_atomic
 from ara.training.config import TrainConfig
 from ara.training.export import PARITY_PAIRS, export_checked
-from ara.training.run_folder import (checkpoint_step, exclusive, held, log_rows,
-                                     whole_checkpoints)
+from ara.training.run_folder import checkpoint_step, exclusive, held, log_rows, whole_checkpoints
 from ara.training.stages import REPLACED, Stage, StagedRecipe
 
 
