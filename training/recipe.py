@@ -40,6 +40,7 @@ from ara.training.dataset import (
 from ara.training.hf_model import forward_in, load_tokenizer, training_dtype, warm_started
 from ara.training.run_folder import (
     adapter_identity,
+    checkpoint_folder,
     exclusive,
     log_summary,
     refuse_changed_config,
@@ -290,7 +291,7 @@ class LoRAFinetuneRecipe:
         """Adapter, optimizer, scheduler and RNG state at the current step; then the
         oldest checkpoints beyond ``keep_checkpoints`` go (only once the new one is whole,
         so an interruption never leaves the run without one)."""
-        folder = self.out / "checkpoints" / f"step_{self.step}"
+        folder = checkpoint_folder(self.out, self.step)
         if folder.joinpath("step.json").is_file():
             # Already whole (the last step is also a checkpoint step): writing it again in
             # place would leave a torn checkpoint that still reads as whole if killed.

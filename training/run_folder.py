@@ -56,8 +56,13 @@ def held(out: Path) -> bool:
         return False
 
 
+def checkpoint_folder(out: Path, step: int) -> Path:
+    """Where run folder ``out`` keeps its checkpoint of ``step``."""
+    return out / "checkpoints" / f"step_{step}"
+
+
 def checkpoint_step(checkpoint: Path) -> int:
-    """The step a checkpoint folder (``checkpoints/step_N``) was saved at."""
+    """The step a :func:`checkpoint_folder` was saved at."""
     return int(checkpoint.name.removeprefix("step_"))
 
 
