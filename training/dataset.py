@@ -21,6 +21,7 @@ from ara.errors import ConfigError
 from ara.eval.translate.prompt import STOP, Shot, build_prompt
 from ara.eval.translate.translator import ANSWER_PREFIX
 from ara.kv_cache import cache_of, with_cache
+from ara.output_layer import output_rows
 
 IGNORE = -100
 
@@ -140,12 +141,11 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
     vocabulary head only there. Several processes sharing one batch add their sums and
     counts, so that their loss is the single-process mean over the whole batch.
 
-    Gemma's output layer (262k x hidden) costs more than the rest of a 270M model; the
-    logits at position t predict token t+1, so only the positions right before an
-    answer token go through it. ``logits_to_keep`` keeps columns for every row alike,
-    and right-padded answers sit in different columns (their union is several times
-    the answer tokens), so a hook on the output layer passes it each row's own answer
-    positions alone; the model's own forward still runs, so wrappers (peft, DDP) see it.
+    The output layer (:mod:`ara.output_layer`) runs only where it is needed: the logits
+    at position t predict token t+1, so only the positions right before an answer
+    token. ``logits_to_keep`` keeps columns for every row alike, and right-padded answers
+    sit in different columns (their union is several times the answer tokens), so each
+    row's own answer positions are picked after it.
 
     Every prompt starts with the same instructions, about half of a training sequence.
     With ``share_prefix`` that common prefix runs once, for one row, and its keys and
@@ -161,25 +161,18 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
     picked = torch.searchsorted(keep, cols)
     ids, mask = batch["input_ids"], batch["attention_mask"]
     shared = min(shared_prefix_length(batch), int(keep.min())) if share_prefix else 0
-    # The hidden states the output layer gets, two-dimensional: a (1, tokens, hidden)
-    # input takes a batched product, which in bf16 on a CPU first copies the whole
-    # transposed 262k-row layer (more than a third of a step).
-    pick = [lambda h: h[0, :0]]  # the prefix's keys and values are wanted, no logit
-    head = getattr(model, "module", model).get_output_embeddings()
-    hook = head.register_forward_pre_hook(lambda _, args: (pick[-1](args[0]), *args[1:]))
-    try:
-        if shared < 2 or ids.shape[0] == 1:
-            inputs = {"input_ids": ids, "attention_mask": mask, "logits_to_keep": keep}
-        else:
+    if shared < 2 or ids.shape[0] == 1:
+        inputs = {"input_ids": ids, "attention_mask": mask, "logits_to_keep": keep}
+    else:
+        # The prefix's keys and values are wanted, no logit.
+        with output_rows(model, lambda h: h[0, :0]):
             prefix = model(input_ids=ids[:1, :shared], use_cache=True, logits_to_keep=1)
-            cache = cache_of(prefix)
-            cache.batch_repeat_interleave(ids.shape[0])
-            inputs = {"input_ids": ids[:, shared:], "attention_mask": mask,
-                      **with_cache(cache), "logits_to_keep": keep - shared}
-        pick.append(lambda h: h[rows, picked])
+        cache = cache_of(prefix)
+        cache.batch_repeat_interleave(ids.shape[0])
+        inputs = {"input_ids": ids[:, shared:], "attention_mask": mask,
+                  **with_cache(cache), "logits_to_keep": keep - shared}
+    with output_rows(model, lambda h: h[rows, picked]):
         out = model(**inputs)
-    finally:
-        hook.remove()
     logits = out.logits.reshape(-1, out.logits.shape[-1])  # (answer tokens, vocab)
     total = torch.nn.functional.cross_entropy(logits.float(), gathered, reduction="sum")
     return total, int(gathered.numel())

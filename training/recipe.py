@@ -343,10 +343,6 @@ class LoRAFinetuneRecipe:
 
         n, form = self.config.eval_pairs, self.config.data.forms[0]
         model = self.accelerator.unwrap_model(self.model).eval()
-        # Generation feeds the output layer (1, tokens, hidden) inputs, whose batched
-        # product in bf16 copies the whole transposed 262k-row layer at every token:
-        # the check runs in fp32 (it comes last; the adapter is saved by then).
-        model = model.float()
         backend = HFBackend.from_objects(model, self.tokenizer, f"lora:{self.out.name}")
         translator = Translator(backend)
         tests = self.split.records("test", form)[:n]

@@ -23,6 +23,7 @@ from ara.eval.translate.backends.base import BackendError, Completion, Sampling
 from ara.eval.translate.backends.masking import GrammarMatcher, Sampler, greedy_decode, score_paths
 from ara.grammars import BuiltGrammar
 from ara.kv_cache import cache_of, with_cache
+from ara.output_layer import output_rows
 
 MASK_ENGINES = ("llguidance", "outlines")
 
@@ -94,12 +95,12 @@ class HFBackend:
     def _forward(self, ids: list[int]) -> np.ndarray:
         """Feed ``ids`` after the cached ones; the last position's logits as float32."""
         torch = self._torch
-        with torch.inference_mode():
+        with torch.inference_mode(), output_rows(self.model, lambda h: h[0, -1:]):
             out = self.model(input_ids=torch.tensor([ids], device=self.device),
                              use_cache=True, **with_cache(self._cache))
         self._cache = cache_of(out)
         self._cached_ids += ids
-        return out.logits[0, -1].float().cpu().numpy()
+        return out.logits[-1].float().cpu().numpy()
 
     def _feed_prompt(self, ids: list[int]) -> tuple[np.ndarray, int]:
         from transformers import DynamicCache
@@ -150,12 +151,12 @@ class HFBackend:
         if start < len(self._cached_ids):  # crop(0) would empty the cache
             self._cache.crop(start - len(self._cached_ids))
             self._cached_ids = self._cached_ids[:start]
-        with torch.inference_mode():
+        with torch.inference_mode(), output_rows(self.model, lambda h: h[0]):
             out = self.model(input_ids=torch.tensor([tokens], device=self.device),
                              use_cache=True, **with_cache(self._cache))
         self._cache = cache_of(out)
         self._cached_ids += tokens
-        return out.logits[0].float().cpu().numpy()
+        return out.logits.float().cpu().numpy()
 
     def _complete_outlines(self, prompt: str, grammar: BuiltGrammar,
                            max_tokens: int) -> Completion:
