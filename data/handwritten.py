@@ -22,15 +22,15 @@ maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfir
 forestry) was written blind on 2026-11-27 by the same rules; ``handwritten/suite8.yaml``
 (split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
 and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
-the same rules; it judged repair's window check (``G[a,b](F)``) that day, while suite 7
-waits for the recipe's run on generator 3.9; ``handwritten/suite9.yaml`` (split ``handwritten9``,
+the same rules; it judged repair's window check (``G[a,b](F)``) that day; suite 7
+judged the recipe's run on generator 3.9 (2026-11-28); ``handwritten/suite9.yaml`` (split ``handwritten9``,
 149 entries: data centers and server rooms, film and TV sets, car washes and vehicle
 service bays, zoos and animal care, recycling and waste sorting plants) was written blind
 on 2026-11-27 by the same rules; it judged repair's condition check that day;
 ``handwritten/suite10.yaml`` (split ``handwritten10``, 163 entries: elder care and
 nursing homes, electrical substations and power lines, theme parks and rides, laundries
 and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
-same rules, to judge the change after that check.
+same rules, to judge the change after that check: the recipe's third run.
 """
 
 from __future__ import annotations
@@ -55,8 +55,8 @@ _NAMED = sorted(filter(None, (re.fullmatch(r"suite([2-9]|[1-9]\d+)?", p.stem)
 SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
-WAITING = {"handwritten7": "the recipe's run on generator 3.9",
-           "handwritten10": "the change after the condition check"}
+WAITING = {"handwritten10": "the recipe's third run (the help requests four times in its "
+                            "refinements)"}
 
 
 @dataclass(frozen=True)
