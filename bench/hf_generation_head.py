@@ -10,7 +10,9 @@ grounded instructions (seed 0), side by side in one process after one warm-up an
 fp32 and bf16 as the backend runs them, and bf16 with the output layer given the usual
 ``(1, tokens, hidden)`` input, whose batched product copies the transposed 262k-row
 layer at every token. Prints the median and mean ms per answer, the ratios to fp32,
-and how many answers agree with fp32's.
+and how many answers agree with fp32's. The base model runs without an adapter; the
+held-out check's PEFT model (fp32 LoRA factors over the base) adds to bf16's cost, not
+fp32's.
 """
 
 from __future__ import annotations

@@ -19,18 +19,20 @@ answered it, and is never read to guide anything; ``handwritten/suite6.yaml``
 operations, security patrol) was written blind on 2026-11-27 by the same rules;
 ``handwritten/suite7.yaml`` (split ``handwritten7``, 147 entries: solar and wind farm
 maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfire and
-forestry) was written blind on 2026-11-27 by the same rules; ``handwritten/suite8.yaml``
+forestry) was written blind on 2026-11-27 by the same rules and judged the recipe's run
+on generator 3.9 (2026-11-27/28); ``handwritten/suite8.yaml``
 (split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
 and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
-the same rules; it judged repair's window check (``G[a,b](F)``) that day; suite 7
-judged the recipe's run on generator 3.9 (2026-11-28); ``handwritten/suite9.yaml`` (split ``handwritten9``,
+the same rules; it judged repair's window check (``G[a,b](F)``) that day;
+``handwritten/suite9.yaml`` (split ``handwritten9``,
 149 entries: data centers and server rooms, film and TV sets, car washes and vehicle
 service bays, zoos and animal care, recycling and waste sorting plants) was written blind
 on 2026-11-27 by the same rules; it judged repair's condition check that day;
 ``handwritten/suite10.yaml`` (split ``handwritten10``, 163 entries: elder care and
 nursing homes, electrical substations and power lines, theme parks and rides, laundries
 and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
-same rules, to judge the change after that check: the recipe's third run.
+same rules, to judge the change after that check, and kept (since 2026-11-28) for the
+recipe's third run.
 """
 
 from __future__ import annotations

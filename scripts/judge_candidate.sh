@@ -14,8 +14,8 @@
 # the shipped file's sha256, 8 digits; V: the registered compositional version), so a
 # rerun after an interruption goes on, and another candidate or data version gets its
 # own folder. DRY_RUN=1 prints the commands instead. Ship only if the candidate is at
-# least as good on the blind sets (`scripts/ship_adapter.py`), then take JUDGE out of
-# WAITING.
+# least as good on the blind sets (`scripts/ship_adapter.py`); shipped or not, take JUDGE
+# out of WAITING once it has answered.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage="usage: scripts/judge_candidate.sh CANDIDATE.gguf JUDGE"

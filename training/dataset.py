@@ -145,7 +145,8 @@ def answer_loss_sum(model, batch: dict[str, torch.Tensor], share_prefix: bool = 
     at position t predict token t+1, so only the positions right before an answer
     token. ``logits_to_keep`` keeps columns for every row alike, and right-padded answers
     sit in different columns (their union is several times the answer tokens), so each
-    row's own answer positions are picked after it.
+    row's own answer positions are picked from the kept columns before the output layer
+    runs.
 
     Every prompt starts with the same instructions, about half of a training sequence.
     With ``share_prefix`` that common prefix runs once, for one row, and its keys and

@@ -334,7 +334,8 @@ class LoRAFinetuneRecipe:
         """Validity and accuracy of the tuned model on test pairs, through the harness,
         with each prompt layout it trained on (each count of worked examples).
 
-        The top-level ``validity`` and ``accuracy`` are those of the weakest layout.
+        The top-level ``validity`` and ``accuracy`` are those of the weakest layout. Call
+        it last: on a CPU it casts the model to fp32 for good.
         """
         from ara.eval.translate.backends.hf_backend import HFBackend
         from ara.eval.translate.prompt import sample_shots

@@ -159,7 +159,8 @@ def test_adapter_and_heldout_check_through_the_harness(tiny_gemma_dir, tmp_path)
 def test_a_bf16_run_keeps_its_adapter_and_loss_in_fp32(tiny_gemma_dir, tmp_path):
     """Tests ``precision: bf16``: the frozen base in bf16, the LoRA weights (what is
     trained and saved) in fp32, a first loss as fp32's (the golden run's first batch) and
-    falling, each step logged as bf16, and the held-out check generating from it."""
+    falling, each step logged as bf16, and the held-out check (which casts to fp32 on a
+    CPU) generating from it."""
     import torch
 
     from ara.training.tiny import GOLDEN_RUN

@@ -95,6 +95,7 @@ class HFBackend:
     def _forward(self, ids: list[int]) -> np.ndarray:
         """Feed ``ids`` after the cached ones; the last position's logits as float32."""
         torch = self._torch
+        # h[0, -1:] and not h[0, -1]: the output layer gets 2-D rows (ara.output_layer).
         with torch.inference_mode(), output_rows(self.model, lambda h: h[0, -1:]):
             out = self.model(input_ids=torch.tensor([ids], device=self.device),
                              use_cache=True, **with_cache(self._cache))
