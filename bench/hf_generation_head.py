@@ -3,16 +3,16 @@ output layer two-dimensional rows (:mod:`ara.output_layer`) saves in bf16.
 
     .venv/bin/python bench/hf_generation_head.py [--n 12]
 
-The recipe's held-out check generates with the model it trains, in the precision it
-trains in (bf16 on a CPU with AMX). Three rows on the embedded Gemma 3 270M (the HF
-folder `ara model prepare` makes), zero-shot under the grammar, on ``--n`` hand-written
-grounded instructions (seed 0), side by side in one process after one warm-up answer:
-fp32 and bf16 as the backend runs them, and bf16 with the output layer given the usual
-``(1, tokens, hidden)`` input, whose batched product copies the transposed 262k-row
-layer at every token. Prints the median and mean ms per answer, the ratios to fp32,
-and how many answers agree with fp32's. The base model runs without an adapter; the
-held-out check's PEFT model (fp32 LoRA factors over the base) adds to bf16's cost, not
-fp32's.
+Whether the recipe's held-out check should generate in the precision it trains in (bf16
+on a CPU with AMX) or cast to fp32 first (what it does on a CPU). Three rows on the
+embedded Gemma 3 270M (the HF folder `ara model prepare` makes), zero-shot under the
+grammar, on ``--n`` hand-written grounded instructions (seed 0), side by side in one
+process after one warm-up answer: fp32 and bf16 as the backend runs them, and bf16 with
+the output layer given the usual ``(1, tokens, hidden)`` input, whose batched product
+copies the transposed 262k-row layer at every token. Prints the median and mean ms per
+answer, the ratios to fp32, and how many answers agree with fp32's. The base model runs
+without an adapter; the held-out check's PEFT model (fp32 LoRA factors over the base)
+adds to bf16's cost, not fp32's.
 """
 
 from __future__ import annotations
