@@ -58,7 +58,7 @@ SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
 WAITING = {"handwritten10": "the recipe's third run (the help requests four times in its "
-                            "refinements)"}
+                            "refinements, a soup of three)"}
 
 
 @dataclass(frozen=True)
