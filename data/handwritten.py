@@ -32,7 +32,10 @@ on 2026-11-27 by the same rules; it judged repair's condition check that day;
 nursing homes, electrical substations and power lines, theme parks and rides, laundries
 and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
 same rules, to judge the change after that check, and kept (since 2026-11-28) for the
-recipe's third run.
+recipe's third run; ``handwritten/suite11.yaml`` (split ``handwritten11``, 165 entries:
+ski resorts, museums and galleries, breweries and wineries, swimming pools and aquatic
+centers, parking garages and car parks) was written blind on 2026-11-28 by the same
+rules, to judge the change after the recipe's third run.
 """
 
 from __future__ import annotations
@@ -58,7 +61,8 @@ SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
 WAITING = {"handwritten10": "the recipe's third run (the help requests four times in its "
-                            "refinements, a soup of three)"}
+                            "refinements, a soup of three)",
+           "handwritten11": "the change after the recipe's third run"}
 
 
 @dataclass(frozen=True)
@@ -79,7 +83,8 @@ class SuiteEntry:
             ``venue``, ``water`` or ``snow`` (the eighth); ``lifted``, ``datacenter``,
             ``film``, ``carwash``, ``zoo`` or ``recycling`` (the ninth); ``lifted``,
             ``eldercare``, ``substation``, ``themepark``, ``laundry`` or ``bridge``
-            (the tenth).
+            (the tenth); ``lifted``, ``ski``, ``museum``, ``brewery``, ``pool`` or
+            ``parking`` (the eleventh).
     """
 
     nl: str
