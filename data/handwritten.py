@@ -31,8 +31,8 @@ on 2026-11-27 by the same rules; it judged repair's condition check that day;
 ``handwritten/suite10.yaml`` (split ``handwritten10``, 163 entries: elder care and
 nursing homes, electrical substations and power lines, theme parks and rides, laundries
 and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
-same rules, to judge the change after that check, and kept (since 2026-11-28) for the
-recipe's third run; ``handwritten/suite11.yaml`` (split ``handwritten11``, 165 entries:
+same rules, to judge the change after that check, and kept for the recipe's third run,
+which it judged on 2026-11-28; ``handwritten/suite11.yaml`` (split ``handwritten11``, 165 entries:
 ski resorts, museums and galleries, breweries and wineries, swimming pools and aquatic
 centers, parking garages and car parks) was written blind on 2026-11-28 by the same
 rules, to judge the change after the recipe's third run.
@@ -60,9 +60,7 @@ _NAMED = sorted(filter(None, (re.fullmatch(r"suite([2-9]|[1-9]\d+)?", p.stem)
 SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
-WAITING = {"handwritten10": "the recipe's third run (the help requests four times in its "
-                            "refinements, a soup of three)",
-           "handwritten11": "the change after the recipe's third run"}
+WAITING = {"handwritten11": "the change after the recipe's third run"}
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ def test_the_judge_must_be_a_suite_kept_blind_for_the_change(tmp_path):
     candidate.write_bytes(b"")
     done = judge(str(candidate), "handwritten4", DRY_RUN="1")
     assert done.returncode == 2 and "handwritten4 is not a blind suite waiting" in done.stderr
-    assert "handwritten10" in done.stderr  # the ones that may judge are named
+    assert "handwritten11" in done.stderr  # the ones that may judge are named
 
 
 def test_a_waiting_suite_judges_both_models_in_a_folder_of_their_own(tmp_path):
@@ -31,20 +31,20 @@ def test_a_waiting_suite_judges_both_models_in_a_folder_of_their_own(tmp_path):
 
     candidate = tmp_path / "lora.gguf"
     candidate.write_bytes(b"")
-    done = judge(str(candidate), "handwritten10", DRY_RUN="1")
+    done = judge(str(candidate), "handwritten11", DRY_RUN="1")
     assert done.returncode == 0, done.stderr
     version = registered_version("compositional")
     root = next(w for w in done.stdout.split() if w.startswith("judge-"))
     assert root.startswith("judge-e3b0c442-") and root.rstrip(":").endswith(version)
     plan = [line for line in done.stdout.splitlines() if line.startswith("would run:")]
-    assert any(f"lora:{candidate} {root.rstrip(':')}/candidate-repair8 handwritten10" in line
+    assert any(f"lora:{candidate} {root.rstrip(':')}/candidate-repair8 handwritten11" in line
                for line in plan)
-    assert any("finetuned" in line and "shipped-greedy handwritten10" in line for line in plan)
+    assert any("finetuned" in line and "shipped-greedy handwritten11" in line for line in plan)
     assert sum("ara eval diff" in line for line in plan) == 4
     assert any("handwritten9" in line and "compositional timed" in line for line in plan)
 
 
 def test_a_missing_candidate_is_named(tmp_path):
-    done = judge(str(tmp_path / "lora.gguf"), "handwritten10")
+    done = judge(str(tmp_path / "lora.gguf"), "handwritten11")
     assert done.returncode == 2 and f"no file {tmp_path / 'lora.gguf'}" in done.stderr
     assert judge().returncode != 0  # and the usage line without arguments
