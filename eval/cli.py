@@ -375,6 +375,27 @@ def diff_cmd(
     emit(result, as_json, lambda d: diff_markdown(d, show))
 
 
+@eval_app.command("verdict")
+def verdict_cmd(
+    folder: Path = typer.Argument(..., help="A judge's folder (scripts/judge_candidate.sh)."),
+    judge: str = typer.Option(..., "--judge", help="The blind suite that judged the change."),
+    max_drop: float = typer.Option(1.0, "--max-drop",
+                                   help="Points any other set may fall below the shipped file."),
+    help_misses: int = typer.Option(0, "--help-misses",
+                                    help="Help requests the candidate may get wrong beyond "
+                                         "the shipped file's."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """Whether a judged candidate may replace the shipped adapter, check by check (no model
+    needed); writes verdict.json into FOLDER, which scripts/ship_adapter.py reads."""
+    from ara.eval.verdict import ShippingRule, verdict, verdict_markdown
+
+    with user_errors():
+        result = verdict(folder, judge, ShippingRule(max_drop, help_misses)).to_dict()
+    (folder / "verdict.json").write_text(json.dumps(result, indent=2) + "\n")
+    emit(result, as_json, verdict_markdown)
+
+
 @eval_app.command("ceiling")
 def ceiling_cmd(
     split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),

@@ -13,9 +13,9 @@
 # hour). Everything goes to runs/generalization/judge-C-S-V/ (C, S: the candidate's and
 # the shipped file's sha256, 8 digits; V: the registered compositional version), so a
 # rerun after an interruption goes on, and another candidate or data version gets its
-# own folder. DRY_RUN=1 prints the commands instead. Ship only if the candidate is at
-# least as good on the blind sets (`scripts/ship_adapter.py`); shipped or not, take JUDGE
-# out of WAITING once it has answered.
+# own folder. DRY_RUN=1 prints the commands instead. It ends with `ara eval verdict`,
+# the shipping rule checked set by set into verdict.json, which `scripts/ship_adapter.py`
+# reads; shipped or not, take JUDGE out of WAITING once it has answered.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage="usage: scripts/judge_candidate.sh CANDIDATE.gguf JUDGE"
@@ -58,10 +58,14 @@ eval_sets C 0 "$model" candidate-greedy $others compositional timed
 eval_sets C 0 finetuned shipped-greedy $others compositional timed
 run $py scripts/generalization_table.py --results "runs/generalization/$root" \
   --models shipped-greedy,candidate-greedy
-step "the help request"
+step "the help request, candidate and shipped"
 mkdir -p "runs/generalization/$root"
-run $py bench/help_request_wordings.py --model "$model" \
-  --out "runs/generalization/$root/help-request-wordings.json"
+help_of() {  # MODEL FILE: skipped where an earlier, interrupted judge wrote it
+  [ -f "runs/generalization/$root/$2" ] ||
+    run $py bench/help_request_wordings.py --model "$1" --out "runs/generalization/$root/$2"
+}
+help_of "$model" help-request-wordings.json
+help_of finetuned help-request-wordings-shipped.json
 if [ "${PAPER:-1}" != 0 ]; then
   step "the paper split, lifted test side, repair 8"
   run .venv/bin/ara eval ablation --split paper --form lifted --limit 3000 --model "$model" \
@@ -69,4 +73,6 @@ if [ "${PAPER:-1}" != 0 ]; then
     --repair-by samples+edits --doubt 0.5 --no-progress \
     --out "runs/generalization/$root/paper-repair8"
 fi
+step "the verdict (the shipping rule: ara eval verdict --help)"
+run .venv/bin/ara eval verdict "runs/generalization/$root" --judge "$judge"
 step "done: runs/generalization/$root"

@@ -11,7 +11,10 @@ into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT
 of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
 merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
 `--min-agreement` nothing is shipped. Judge the candidate against the shipped file first
-(`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`).
+(`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`): the default file (`--model
+finetuned`) ships only where that judge's `verdict.json` (found by the adapter's hash
+under `runs/generalization/`, or given with `--verdict`) says it ships, or with
+`--despite REASON`, which the record keeps beside the failed checks.
 """
 
 from __future__ import annotations
@@ -40,7 +43,33 @@ def export_folders(path: Path) -> tuple[Path, Path]:
     return run, export
 
 
-def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20) -> dict:
+DEFAULT_NAME = "gemma3-270m-nl2tl-lora.gguf"
+
+
+def judged(adapter: Path, given: Path | None, despite: str | None) -> dict:
+    """What the record keeps of the judge of ``adapter``; raises where the rule stops it."""
+    from ara.provenance import sha256_file
+
+    if given is None:
+        found = sorted(Path("runs/generalization").glob(
+            f"judge-{sha256_file(adapter)[:8]}-*/verdict.json"))
+        given = found[-1] if found else None
+    if given is None or not given.is_file():
+        if despite:
+            return {"verdict": None, "despite": despite}
+        raise ConfigError(f"no verdict for {adapter}: judge it first (scripts/"
+                          "judge_candidate.sh), or ship it --despite REASON")
+    result = json.loads(given.read_text())
+    if not result["ships"] and not despite:
+        failed = "; ".join(f"{c['name']}: {c['why']}" for c in result["checks"]
+                           if not c["passed"])
+        raise ConfigError(f"{given} says it does not ship ({failed}); --despite REASON "
+                          "overrides it, and the record keeps the reason")
+    return {"verdict": {"file": str(given), **result}, "despite": despite}
+
+
+def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20,
+         judge: dict | None = None) -> dict:
     from ara.data import load_or_prepare
     from ara.eval.translate.llama_check import default_model_path
     from ara.eval.translate.models import SHIPPED
@@ -74,7 +103,8 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
                     "what": "embedded Q4_K_M GGUF + this adapter (llama.cpp) vs the merged HF "
                             f"model (transformers, fp32), greedy, zero-shot, unconstrained; "
                             f"{pairs} lifted + {pairs} grounded {split} test pairs",
-                    **checked}}
+                    **checked},
+                "judged": judge}
     target.with_suffix(".json").write_text(json.dumps(manifest, indent=2) + "\n")
     return manifest
 
@@ -82,15 +112,24 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("export", type=Path, help="the export stage, or an exported run folder")
-    parser.add_argument("--name", default="gemma3-270m-nl2tl-lora.gguf",
+    parser.add_argument("--name", default=DEFAULT_NAME,
                         help="file name in eval/models/ (default: the --model finetuned one)")
     parser.add_argument("--split", default="compositional",
                         help="split whose test pairs the parity check reads")
     parser.add_argument("--min-agreement", type=float, default=0.9,
                         help="ship only when at least this share of greedy answers agree")
+    parser.add_argument("--verdict", type=Path,
+                        help="the judge's verdict.json (default: found by the adapter's hash)")
+    parser.add_argument("--despite", metavar="REASON",
+                        help="ship the default file although its verdict says no (or it has "
+                             "none); the record keeps REASON")
     args = parser.parse_args(argv)
     try:
-        manifest = ship(args.export, args.name, args.split, args.min_agreement)
+        judge = None
+        if args.name == DEFAULT_NAME:
+            judge = judged(export_folders(args.export)[1] / "lora.gguf", args.verdict,
+                           args.despite)
+        manifest = ship(args.export, args.name, args.split, args.min_agreement, judge=judge)
     except ConfigError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
