@@ -387,12 +387,17 @@ def verdict_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Whether a judged candidate may replace the shipped adapter, check by check (no model
-    needed); writes verdict.json into FOLDER, which scripts/ship_adapter.py reads."""
+    needed). It ships when it is right on at least as many of the judge's answers as the
+    shipped file (greedy and with repair), on no other held-out set more than --max-drop
+    points below it, on at least as many help requests (less --help-misses), with no more
+    invalid answers. Writes verdict.json into FOLDER, which scripts/ship_adapter.py reads;
+    exits 0 either way."""
     from ara.eval.verdict import ShippingRule, verdict, verdict_markdown
+    from ara.provenance import write_atomic
 
     with user_errors():
         result = verdict(folder, judge, ShippingRule(max_drop, help_misses)).to_dict()
-    (folder / "verdict.json").write_text(json.dumps(result, indent=2) + "\n")
+        write_atomic(folder / "verdict.json", json.dumps(result, indent=2) + "\n")
     emit(result, as_json, verdict_markdown)
 
 

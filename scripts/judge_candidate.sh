@@ -59,7 +59,7 @@ eval_sets C 0 finetuned shipped-greedy $others compositional timed
 run $py scripts/generalization_table.py --results "runs/generalization/$root" \
   --models shipped-greedy,candidate-greedy
 step "the help request, candidate and shipped"
-mkdir -p "runs/generalization/$root"
+run mkdir -p "runs/generalization/$root"
 help_of() {  # MODEL FILE: skipped where an earlier, interrupted judge wrote it
   [ -f "runs/generalization/$root/$2" ] ||
     run $py bench/help_request_wordings.py --model "$1" --out "runs/generalization/$root/$2"

@@ -11,10 +11,11 @@ into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT
 of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
 merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
 `--min-agreement` nothing is shipped. Judge the candidate against the shipped file first
-(`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`): the default file (`--model
-finetuned`) ships only where that judge's `verdict.json` (found by the adapter's hash
-under `runs/generalization/`, or given with `--verdict`) says it ships, or with
-`--despite REASON`, which the record keeps beside the failed checks.
+(`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`): a shipped file is replaced only
+where that judge's `verdict.json` (`runs/generalization/judge-C-S-V/`, named by both
+files' hashes and the data version, or given with `--verdict`) says the candidate ships
+by the default rule, or with `--despite REASON`, which the record keeps beside the
+verdict.
 """
 
 from __future__ import annotations
@@ -43,29 +44,42 @@ def export_folders(path: Path) -> tuple[Path, Path]:
     return run, export
 
 
+REPO = Path(__file__).resolve().parents[1]
 DEFAULT_NAME = "gemma3-270m-nl2tl-lora.gguf"
 
 
-def judged(adapter: Path, given: Path | None, despite: str | None) -> dict:
-    """What the record keeps of the judge of ``adapter``; raises where the rule stops it."""
+def judged(adapter: Path, target: Path, given: Path | None, despite: str | None) -> dict:
+    """What the record keeps of the judge of ``adapter`` against ``target``, the file it
+    replaces; raises where the shipping rule stops it and no reason overrides it."""
+    from dataclasses import asdict
+
+    from ara.data import registered_version
+    from ara.eval.verdict import ShippingRule
     from ara.provenance import sha256_file
 
-    if given is None:
-        found = sorted(Path("runs/generalization").glob(
-            f"judge-{sha256_file(adapter)[:8]}-*/verdict.json"))
-        given = found[-1] if found else None
-    if given is None or not given.is_file():
-        if despite:
-            return {"verdict": None, "despite": despite}
-        raise ConfigError(f"no verdict for {adapter}: judge it first (scripts/"
-                          "judge_candidate.sh), or ship it --despite REASON")
-    result = json.loads(given.read_text())
-    if not result["ships"] and not despite:
-        failed = "; ".join(f"{c['name']}: {c['why']}" for c in result["checks"]
-                           if not c["passed"])
-        raise ConfigError(f"{given} says it does not ship ({failed}); --despite REASON "
-                          "overrides it, and the record keeps the reason")
-    return {"verdict": {"file": str(given), **result}, "despite": despite}
+    # The judge's folder names both files and the data it judged on: a verdict against
+    # an earlier shipped file, or another candidate's, says nothing about this one.
+    expected = (f"judge-{sha256_file(adapter)[:8]}-{sha256_file(target)[:8]}-"
+                f"{registered_version('compositional')}")
+    given = given or REPO / "runs" / "generalization" / expected / "verdict.json"
+    result, problem = None, None
+    if not given.is_file():
+        problem = f"no verdict {given}: judge the candidate first (scripts/judge_candidate.sh)"
+    else:
+        result = json.loads(given.read_text())
+        if result.get("folder") != expected:
+            problem = f"{given} judged {result.get('folder')}, not {expected}"
+        elif result["rule"] != asdict(ShippingRule()):
+            problem = f"{given} was checked by another rule than the default: {result['rule']}"
+        elif not result["ships"]:
+            failed = "; ".join(f"{c['name']}: {c['why']}" for c in result["checks"]
+                               if not c["passed"])
+            problem = f"{given} says it does not ship ({failed})"
+    if problem and not despite:
+        raise ConfigError(f"{problem}; --despite REASON overrides it, and the record keeps "
+                          "the reason")
+    return {"verdict_file": str(given), "verdict": result, "problem": problem,
+            "despite": despite}
 
 
 def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20,
@@ -119,15 +133,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--min-agreement", type=float, default=0.9,
                         help="ship only when at least this share of greedy answers agree")
     parser.add_argument("--verdict", type=Path,
-                        help="the judge's verdict.json (default: found by the adapter's hash)")
+                        help="the judge's verdict.json (default: the judge folder named by "
+                             "both hashes)")
     parser.add_argument("--despite", metavar="REASON",
-                        help="ship the default file although its verdict says no (or it has "
-                             "none); the record keeps REASON")
+                        help="replace the shipped file although the verdict says no (or there "
+                             "is none); the record keeps REASON")
     args = parser.parse_args(argv)
     try:
-        judge = None
-        if args.name == DEFAULT_NAME:
-            judge = judged(export_folders(args.export)[1] / "lora.gguf", args.verdict,
+        from ara.eval.translate.models import SHIPPED
+
+        judge, target = None, SHIPPED / args.name
+        if target.is_file():  # replacing a shipped file: only as the judge allows
+            judge = judged(export_folders(args.export)[1] / "lora.gguf", target, args.verdict,
                            args.despite)
         manifest = ship(args.export, args.name, args.split, args.min_agreement, judge=judge)
     except ConfigError as error:

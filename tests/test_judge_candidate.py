@@ -42,6 +42,10 @@ def test_a_waiting_suite_judges_both_models_in_a_folder_of_their_own(tmp_path):
     assert any("finetuned" in line and "shipped-greedy handwritten11" in line for line in plan)
     assert sum("ara eval diff" in line for line in plan) == 4
     assert any("handwritten9" in line and "compositional timed" in line for line in plan)
+    assert any("--model finetuned" in line and "help-request-wordings-shipped.json" in line
+               for line in plan)
+    assert plan[-1].endswith(f"ara eval verdict runs/generalization/{root.rstrip(':')} "
+                             "--judge handwritten11")
 
 
 def test_a_missing_candidate_is_named(tmp_path):

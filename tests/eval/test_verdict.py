@@ -1,6 +1,8 @@
 """The shipping rule read off a judge's folder, as `scripts/judge_candidate.sh` leaves it."""
 
+import importlib.util
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -47,7 +49,7 @@ def test_a_loss_elsewhere_beyond_the_rule_stops_it_and_says_where(tmp_path):
     result = verdict(judge_folder(tmp_path, other=(50, 48)), "suiteX")
     assert not result.ships
     assert [(c.name, c.why) for c in result.checks if not c.passed] == [
-        ("other, greedy", "2.0 points below")]
+        ("other, greedy", "2.00 points below (2 fewer right)")]
     assert verdict(tmp_path, "suiteX", ShippingRule(max_drop_points=2)).ships
 
 
@@ -66,10 +68,42 @@ def test_what_was_not_measured_fails_rather_than_passes(tmp_path):
     assert failed == {"other, greedy": "not measured", "help request": "not measured"}
 
 
-def test_an_invalid_answer_or_a_worse_judge_stops_it(tmp_path):
+def test_a_worse_judge_or_an_invalid_answer_stops_it(tmp_path):
+    """Tests that the judge allows no answer fewer, greedy or with repair, and that an
+    invalid answer the shipped file does not give fails the candidate."""
     judge_folder(tmp_path, judge=(12, 11))
     failed = [c.name for c in verdict(tmp_path, "suiteX").checks if not c.passed]
     assert failed == ["suiteX (the judge), greedy", "suiteX (the judge), repair8"]
+    shutil.rmtree(tmp_path / "candidate-repair8/suiteX-grounded")
+    answers(tmp_path / "candidate-repair8/suiteX-grounded", 12, 20, invalid=1)
+    failed = {c.name: c.why for c in verdict(tmp_path, "suiteX").checks if not c.passed}
+    assert failed == {"suiteX (the judge), greedy": "1 fewer right",
+                      "invalid answers": "more invalid answers"}
+
+
+def test_an_interrupted_run_cannot_pass(tmp_path):
+    """Tests that a set whose runs answered other pairs (the candidate's stopped after 10
+    answers, all right) fails as not measured instead of comparing shares."""
+    judge_folder(tmp_path)
+    shutil.rmtree(tmp_path / "candidate-greedy/other-grounded")
+    answers(tmp_path / "candidate-greedy/other-grounded", 10, 10)
+    failed = {c.name: c.why for c in verdict(tmp_path, "suiteX").checks if not c.passed}
+    assert failed == {"other, greedy": "not measured: the two runs answered other pairs "
+                                       "(one interrupted?)"}
+
+
+def test_runs_on_an_earlier_data_version_are_not_read(tmp_path):
+    judge_folder(tmp_path)
+    answers(tmp_path / "candidate-greedy/other-lifted@0123456789ab", 0, 50)
+    assert verdict(tmp_path, "suiteX").ships
+
+
+def test_a_judge_with_no_runs_is_named_with_the_sets_there(tmp_path):
+    judge_folder(tmp_path)
+    with pytest.raises(ConfigError, match="no runs of suiteY; it has other, suiteX"):
+        verdict(tmp_path, "suiteY")
+    with pytest.raises(ConfigError, match="no evaluation runs"):
+        verdict(tmp_path / "nothing", "suiteX")
 
 
 def test_a_rule_out_of_range_is_refused():
@@ -79,24 +113,51 @@ def test_a_rule_out_of_range_is_refused():
         ShippingRule(help_misses=-2)
 
 
-def test_the_verdict_command_writes_what_ship_adapter_refuses_by(tmp_path):
-    """`ara eval verdict` writes verdict.json; `scripts/ship_adapter.py` will not ship the
-    default file against it without a reason, and says which checks failed."""
-    root = judge_folder(tmp_path / "judge", other=(50, 40))
+def shipping_script():
+    spec = importlib.util.spec_from_file_location("ship_adapter", REPO / "scripts/ship_adapter.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def judged_as(tmp_path: Path, candidate: Path, target: Path, **kwargs) -> Path:
+    """The judge's folder of ``candidate`` against ``target``, its verdict written."""
+    from ara.data import registered_version
+    from ara.provenance import sha256_file
+
+    name = (f"judge-{sha256_file(candidate)[:8]}-{sha256_file(target)[:8]}-"
+            f"{registered_version('compositional')}")
+    root = judge_folder(tmp_path / name, **kwargs)
     done = subprocess.run([sys.executable, "-m", "ara.cli", "eval", "verdict", str(root),
                            "--judge", "suiteX"], capture_output=True, text=True, cwd=REPO)
     assert done.returncode == 0, done.stderr
-    assert "verdict: does not ship" in done.stdout and "10.0 points below" in done.stdout
-    assert json.loads((root / "verdict.json").read_text())["ships"] is False
+    return root / "verdict.json"
 
-    export = tmp_path / "export"  # what export_folders needs to find, before any model runs
-    for part in ("lora.gguf", "export.json", "run.json", "adapter/adapter_config.json",
-                 "adapter/adapter_model.safetensors"):
-        (export / part).parent.mkdir(parents=True, exist_ok=True)
-        (export / part).write_text("{}")
-    (export / "merged-hf").mkdir()
-    shipped = subprocess.run([sys.executable, "scripts/ship_adapter.py", str(export),
-                              "--verdict", str(root / "verdict.json")],
-                             capture_output=True, text=True, cwd=REPO)
-    assert shipped.returncode == 2
-    assert "does not ship (other, greedy: 10.0 points below)" in shipped.stderr
+
+def test_a_shipped_file_is_replaced_only_as_its_judge_allows(tmp_path):
+    """Tests the gate `scripts/ship_adapter.py` keeps: a verdict of this candidate against
+    this shipped file, by the default rule, that says it ships; else only a reason."""
+    ship = shipping_script()
+    candidate, target = tmp_path / "lora.gguf", tmp_path / "shipped.gguf"
+    candidate.write_bytes(b"candidate")
+    target.write_bytes(b"shipped")
+
+    passing = judged_as(tmp_path / "a", candidate, target)
+    assert ship.judged(candidate, target, passing, None)["problem"] is None
+    with pytest.raises(ConfigError, match="no verdict"):
+        ship.judged(candidate, target, tmp_path / "none.json", None)
+    target.write_bytes(b"shipped since")  # the verdict was against the file before it
+    with pytest.raises(ConfigError, match="judged judge-.*, not judge-"):
+        ship.judged(candidate, target, passing, None)
+
+    failing = judged_as(tmp_path / "b", candidate, target, other=(50, 40))
+    with pytest.raises(ConfigError, match=r"does not ship \(other, greedy: 10.00 points"):
+        ship.judged(candidate, target, failing, None)
+    kept = ship.judged(candidate, target, failing, "the bids are the template's")
+    assert kept["despite"] == "the bids are the template's" and not kept["verdict"]["ships"]
+
+    lenient = json.loads(failing.read_text()) | {"ships": True, "rule": {"max_drop_points": 20,
+                                                                          "help_misses": 0}}
+    failing.write_text(json.dumps(lenient))
+    with pytest.raises(ConfigError, match="another rule than the default"):
+        ship.judged(candidate, target, failing, None)
