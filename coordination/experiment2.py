@@ -103,7 +103,9 @@ def run_trial(trial: Trial, config: Exp2Config, translator=None) -> list[dict]:
         offer_s.append(time.perf_counter() - t0)
     chosen = choose(offers)
     if chosen is None:
-        row("ours", None, None, sum(offer_s), reason="no helper could help")
+        # What they read and why they declined, which a wrong translation explains.
+        row("ours", None, None, sum(offer_s), stl=offers[0].stl,
+            reason=f"no helper could help ({offers[0].reason})")
     else:
         o = offers[chosen]
         row("ours", o.bid, chosen, sum(offer_s), tau_help=o.tau_help, tau_new=o.tau_new,
