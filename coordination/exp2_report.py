@@ -72,7 +72,7 @@ def _comparisons(rows: list[dict], wait: str) -> dict:
     return out
 
 
-def _translation_summary(rows: list[dict]) -> dict:
+def translation_summary(rows: list[dict]) -> dict:
     """With an LLM: how often the helpers' formula was the template's, and what the
     wrong ones did to the auction (its Delta against the template's, drop wait)."""
     ours = [r for r in rows if r["method"] == "ours"]
@@ -101,7 +101,7 @@ def summarize(rows: list[dict], config: Exp2Config) -> dict:
     by_wait = {w: {"methods": _method_stats(rows, w), "comparisons": _comparisons(rows, w)}
                for w in WAITS}
     chosen = by_wait[config.wait]
-    extra = {"translation": _translation_summary(rows)} if config.llm != "none" else {}
+    extra = {"translation": translation_summary(rows)} if config.llm != "none" else {}
     return {"config": asdict(config), "trials": len({r["trial"] for r in rows}),
             "wait": config.wait, "methods": chosen["methods"],
             "comparisons": chosen["comparisons"], "by_wait": by_wait, **extra,

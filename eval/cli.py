@@ -389,9 +389,9 @@ def verdict_cmd(
     """Whether a judged candidate may replace the shipped adapter, check by check (no model
     needed). It ships when it is right on at least as many of the judge's answers as the
     shipped file (greedy and with repair), on no other held-out set more than --max-drop
-    points below it, on at least as many help requests (less --help-misses), with no more
-    invalid answers. Writes verdict.json into FOLDER, which scripts/ship_adapter.py reads;
-    exits 0 either way."""
+    points below it, on at least as many help requests (less --help-misses), with every
+    auction of Experiment 2 as the template's, and no more invalid answers. Writes
+    verdict.json into FOLDER, which scripts/ship_adapter.py reads; exits 0 either way."""
     from ara.eval.verdict import ShippingRule, verdict, verdict_markdown
     from ara.provenance import write_atomic
 

@@ -12,14 +12,18 @@ into one folder; ``ara eval verdict FOLDER --judge SUITE`` reads it and checks, 
    cannot hide a loss elsewhere;
 3. the help request (``bench/help_request_wordings.py``), which the coordination half
    depends on: at most ``help_misses`` fewer wordings equivalent to the template's spec;
-4. no more invalid answers than the shipped file (under the grammar, both give none).
+4. the help request where it counts, in the paper's Experiment 2 with the candidate
+   translating every request (``ara coord exp2 --llm ... --wordings all``): no auction
+   whose outcome differs from the one the template's spec gives, none left unanswered;
+5. no more invalid answers than the shipped file (under the grammar, both give none).
 
 Both models must have answered the same pairs of a set, else its check fails as not
 measured: an interrupted run cannot pass. The folder's layout is the judge's:
-``{shipped,candidate}-{greedy,repair8}/<set>-<form>/samples.jsonl`` and
-``help-request-wordings{,-shipped}.json``; folders named ``<set>-<form>@<version>`` hold
-runs on an earlier data version and are not read. The paper split, which 97% overlaps
-training, is measured by the judge for the candidate alone and not checked here.
+``{shipped,candidate}-{greedy,repair8}/<set>-<form>/samples.jsonl``,
+``help-request-wordings{,-shipped}.json`` and ``exp2-candidate/summary.json``; folders
+named ``<set>-<form>@<version>`` hold runs on an earlier data version and are not read.
+The paper split, which 97% overlaps training, is measured by the judge for the candidate
+alone and not checked here.
 """
 
 from __future__ import annotations
@@ -147,6 +151,21 @@ def _help(folder: Path, model: str) -> int | None:
     return json.loads(path.read_text())["equivalent"] if path.is_file() else None
 
 
+def _auctions(summary: Path) -> Check:
+    """Experiment 2 with the candidate translating: every auction as the template's."""
+    name = "help requests in Experiment 2"
+    if not summary.is_file():
+        return Check(name, "", "-", False, "not measured")
+    translation = json.loads(summary.read_text()).get("translation")
+    if translation is None:
+        return Check(name, "", "-", False, "not measured: a run without a translator")
+    changed, trials = translation["wrong_formula_changed_delta"], translation["trials"]
+    figure = (f"{trials - changed} of {trials} auctions as the template's "
+              f"({translation['equivalent_to_template']} formulas equivalent)")
+    return Check(name, "", figure, changed == 0,
+                 "" if not changed else f"{changed} auctions differ or go unanswered")
+
+
 def verdict(folder: Path, judge: str, rule: ShippingRule = ShippingRule()) -> Verdict:
     """Check a judge's results against ``rule``.
 
@@ -185,6 +204,7 @@ def verdict(folder: Path, judge: str, rule: ShippingRule = ShippingRule()) -> Ve
         passed = candidate_help >= shipped_help - rule.help_misses
         checks.append(Check("help request", *figures, passed,
                             "" if passed else f"{shipped_help - candidate_help} fewer"))
+    checks.append(_auctions(folder / "exp2-candidate" / "summary.json"))
     invalid = {model: sum(t.pairs - t.valid for kind in ("greedy", "repair8")
                           for t in runs[f"{model}-{kind}"].values()) for model in MODELS}
     passed = invalid["candidate"] <= invalid["shipped"]

@@ -9,7 +9,7 @@
 # models answer it greedy and as `ara translate` does (repair 8), and `ara eval diff`
 # lists what the candidate fixed and broke. Then every other held-out set (the suites
 # not waiting, the compositional test, NL2TL's timed dev), greedy, for both; the help
-# request; and, unless PAPER=0, the paper split's lifted test side with repair (about an
+# request, for both, and Experiment 2 with the candidate translating (15 min); and, unless PAPER=0, the paper split's lifted test side with repair (about an
 # hour). Everything goes to runs/generalization/judge-C-S-V/ (C, S: the candidate's and
 # the shipped file's sha256, 8 digits; V: the registered compositional version), so a
 # rerun after an interruption goes on, and another candidate or data version gets its
@@ -66,6 +66,9 @@ help_of() {  # MODEL FILE: skipped where an earlier, interrupted judge wrote it
 }
 help_of "$model" help-request-wordings.json
 help_of finetuned help-request-wordings-shipped.json
+step "Experiment 2, the candidate translating every request (its auctions against the template's)"
+run .venv/bin/ara coord exp2 --out "runs/generalization/$root/exp2-candidate" --planner milp \
+  --llm "$model" --wordings all
 if [ "${PAPER:-1}" != 0 ]; then
   step "the paper split, lifted test side, repair 8"
   run .venv/bin/ara eval ablation --split paper --form lifted --limit 3000 --model "$model" \

@@ -162,7 +162,7 @@ def test_a_run_with_the_llm_records_its_model_and_resumes_only_with_it(tmp_path,
 def test_the_translation_summary_counts_wrong_formulas_and_their_cost():
     """Tests the LLM record: per wording, how many formulas were the template's, and what
     a wrong one did to Delta, also where one of the two auctions found no helper."""
-    from ara.coordination.exp2_report import _translation_summary
+    from ara.coordination.exp2_report import translation_summary
 
     rows = [{"method": "ours", "wording": 0, "template_equivalent": True, "delta": 4,
              "delta_template": 4, "declined": 0},
@@ -171,7 +171,7 @@ def test_the_translation_summary_counts_wrong_formulas_and_their_cost():
             {"method": "ours", "wording": 1, "template_equivalent": False, "delta": 6,
              "delta_template": None, "declined": 6},
             {"method": "b2", "delta": 9}]
-    seen = _translation_summary(rows)
+    seen = translation_summary(rows)
     assert (seen["trials"], seen["equivalent_to_template"], seen["helpers_declined"]) == (3, 1, 7)
     assert seen["delta_change_when_changed"] == [2, None]
     assert seen["by_wording"] == {"0": {"equivalent": 1, "trials": 1},

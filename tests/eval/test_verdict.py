@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from ara.coordination.exp2_report import translation_summary
 from ara.errors import ConfigError
 from ara.eval.verdict import ShippingRule, verdict
 
@@ -23,8 +24,21 @@ def answers(folder: Path, right: int, pairs: int, invalid: int = 0) -> None:
     (folder / "samples.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
 
 
-def judge_folder(root: Path, *, judge=(10, 12), other=(50, 49), help_=(55, 55)) -> Path:
-    """Shipped and candidate answers on a judge suite and one other set (its two forms)."""
+def experiment2(root: Path, deltas: list[tuple]) -> None:
+    """Experiment 2's summary of trials whose (formula equivalent?, Delta, the template's
+    Delta) are ``deltas``, summarized as `ara coord exp2` summarizes them."""
+    rows = [{"method": "ours", "template_equivalent": same, "delta": delta,
+             "delta_template": template, "wording": i % 11, "declined": int(delta is None)}
+            for i, (same, delta, template) in enumerate(deltas)]
+    (root / "exp2-candidate").mkdir(parents=True, exist_ok=True)
+    (root / "exp2-candidate/summary.json").write_text(
+        json.dumps({"translation": translation_summary(rows)}))
+
+
+def judge_folder(root: Path, *, judge=(10, 12), other=(50, 49), help_=(55, 55),
+                 auctions=((True, 4, 4), (False, 5, 5))) -> Path:
+    """Shipped and candidate answers on a judge suite and one other set (its two forms),
+    the help requests and Experiment 2's auctions."""
     for kind in ("greedy", "repair8"):
         answers(root / f"shipped-{kind}/suiteX-grounded", judge[0], 20)
         answers(root / f"candidate-{kind}/suiteX-grounded", judge[1], 20)
@@ -34,6 +48,7 @@ def judge_folder(root: Path, *, judge=(10, 12), other=(50, 49), help_=(55, 55)) 
     for name, n in zip(("help-request-wordings-shipped.json", "help-request-wordings.json"),
                        help_, strict=True):
         (root / name).write_text(json.dumps({"equivalent": n, "requests": 55}))
+    experiment2(root, list(auctions))
     return root
 
 
@@ -59,13 +74,29 @@ def test_one_help_request_fewer_stops_it_unless_the_rule_allows_it(tmp_path):
     assert verdict(tmp_path, "suiteX", ShippingRule(help_misses=1)).ships
 
 
+def test_an_auction_the_translation_changes_or_leaves_unanswered_stops_it(tmp_path):
+    """Tests that Experiment 2 judges the help request by its auctions: a formula Spot
+    finds unlike the template's passes where the bids are the same, and one trial whose
+    request no helper could plan for fails it."""
+    judge_folder(tmp_path, auctions=[(False, 4, 4)] * 3)
+    assert verdict(tmp_path, "suiteX").ships
+    experiment2(tmp_path, [(True, 4, 4), (False, None, 8)])
+    failed = {c.name: (c.candidate, c.why) for c in verdict(tmp_path, "suiteX").checks
+              if not c.passed}
+    assert failed == {"help requests in Experiment 2": (
+        "1 of 2 auctions as the template's (1 formulas equivalent)",
+        "1 auctions differ or go unanswered")}
+
+
 def test_what_was_not_measured_fails_rather_than_passes(tmp_path):
     judge_folder(tmp_path)
     (tmp_path / "help-request-wordings-shipped.json").unlink()
     for run in (tmp_path / "candidate-greedy").glob("other-*"):
         (run / "samples.jsonl").unlink()
+    shutil.rmtree(tmp_path / "exp2-candidate")
     failed = {c.name: c.why for c in verdict(tmp_path, "suiteX").checks if not c.passed}
-    assert failed == {"other, greedy": "not measured", "help request": "not measured"}
+    assert failed == {"other, greedy": "not measured", "help request": "not measured",
+                      "help requests in Experiment 2": "not measured"}
 
 
 def test_a_worse_judge_or_an_invalid_answer_stops_it(tmp_path):
