@@ -220,6 +220,7 @@ def verdict_markdown(result: dict) -> str:
     rule = result["rule"]
     lines += ["", f"rule: the judge at least as good; no other set more than "
               f"{rule['max_drop_points']:g} points below; at most {rule['help_misses']} help "
-              "requests fewer; no more invalid answers",
+              "requests fewer; every auction of Experiment 2 as the template's; no more invalid "
+              "answers",
               f"verdict: {'ships' if result['ships'] else 'does not ship'}"]
     return "\n".join(lines)
