@@ -62,23 +62,26 @@ def judged(adapter: Path, target: Path, given: Path | None, despite: str | None)
     expected = (f"judge-{sha256_file(adapter)[:8]}-{sha256_file(target)[:8]}-"
                 f"{registered_version('compositional')}")
     given = given or REPO / "runs" / "generalization" / expected / "verdict.json"
+    # A committed record names paths as a clone sees them, not as this checkout lies.
+    shown = (given.resolve().relative_to(REPO) if given.resolve().is_relative_to(REPO)
+             else given)
     result, problem = None, None
     if not given.is_file():
-        problem = f"no verdict {given}: judge the candidate first (scripts/judge_candidate.sh)"
+        problem = f"no verdict {shown}: judge the candidate first (scripts/judge_candidate.sh)"
     else:
         result = json.loads(given.read_text())
         if result.get("folder") != expected:
-            problem = f"{given} judged {result.get('folder')}, not {expected}"
+            problem = f"{shown} judged {result.get('folder')}, not {expected}"
         elif result["rule"] != asdict(ShippingRule()):
-            problem = f"{given} was checked by another rule than the default: {result['rule']}"
+            problem = f"{shown} was checked by another rule than the default: {result['rule']}"
         elif not result["ships"]:
             failed = "; ".join(f"{c['name']}: {c['why']}" for c in result["checks"]
                                if not c["passed"])
-            problem = f"{given} says it does not ship ({failed})"
+            problem = f"{shown} says it does not ship ({failed})"
     if problem and not despite:
         raise ConfigError(f"{problem}; --despite REASON overrides it, and the record keeps "
                           "the reason")
-    return {"verdict_file": str(given), "verdict": result, "problem": problem,
+    return {"verdict_file": str(shown), "verdict": result, "problem": problem,
             "despite": despite}
 
 

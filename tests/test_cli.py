@@ -232,17 +232,17 @@ def test_translate_warns_when_the_answer_leaves_part_of_the_request_out():
 def test_translate_repairs_and_warns_of_operators_the_sentence_never_asks_for():
     """Tests an answer that nests F in G where the sentence never says "again and
     again": greedy decoding (--repair 0) writes it and is warned of, in words and as
-    the `unasked` field; repair, the default, drops the F."""
-    args = ["Always hold the railing firmly.", "--aps", "hold_railing"]
+    the `unasked` field; repair, the default, drops the G."""
+    args = ["Photograph the valves on tank 2.", "--aps", "photograph_tank_2_valves"]
     out = ara("translate", *args, "--repair", "0")
-    assert out.returncode == 0 and out.stdout.strip() == "G(F(hold_railing))"
-    assert ("warning: this answer writes G(F(hold_railing)) (again and again), which the "
-            "sentence never asks for") in out.stderr
+    assert out.returncode == 0 and out.stdout.strip() == "G(F(photograph_tank_2_valves))"
+    assert ("warning: this answer writes G(F(photograph_tank_2_valves)) (again and again), "
+            "which the sentence never asks for") in out.stderr
     answer = json.loads(ara("translate", *args, "--repair", "0", "--json").stdout)
-    assert answer["unasked"] == ["G(F(hold_railing))"]
+    assert answer["unasked"] == ["G(F(photograph_tank_2_valves))"]
     # unbounded: what repair finds, however slow the machine
     answer = json.loads(ara("translate", *args, "--budget", "0", "--json").stdout)
-    assert answer["stl"] == "G(hold_railing)" and answer["unasked"] == []
+    assert answer["stl"] == "F(photograph_tank_2_valves)" and answer["unasked"] == []
 
 
 @needs_llama
@@ -251,7 +251,8 @@ def test_translate_notes_an_answer_the_model_doubts():
     gets an answer the model gives a low probability, read back in English; a plain
     instruction gets neither note nor doubt."""
     # unbounded (--budget 0): what repair weighs, however slow the machine
-    args = ["( prop_1 ) purple elephant ( prop_2 )", "--aps", "prop_1,prop_2", "--budget", "0"]
+    args = ["eventually unless ( prop_1 ) always ( prop_2 )", "--aps", "prop_1,prop_2",
+            "--budget", "0"]
     out = ara("translate", *args)
     assert out.returncode == 0
     assert "note: the model gives this answer a probability of" in out.stderr
@@ -271,7 +272,8 @@ def test_a_doubted_answer_comes_with_the_other_readings_the_model_weighed():
     from ara.grammars import parse
     from ara.grammars.spot_bridge import equivalent
 
-    args = ["( prop_1 ) or ( prop_2 ) at some point", "--aps", "prop_1,prop_2", "--budget", "0"]
+    args = ["Never leave the zone and the door open.", "--aps", "leave_zone,door_open",
+            "--budget", "0"]
     data = json.loads(ara("translate", *args, "--json").stdout)
     assert data["confidence"] < 0.5 and 1 <= len(data["alternatives"]) <= 2
     for other in data["alternatives"]:

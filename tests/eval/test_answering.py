@@ -89,7 +89,7 @@ def test_repair_defaults_to_on_unless_answers_are_voted_or_unconstrained():
 
 
 #: A sentence the shipped model doubts its complete answer to: repair draws for it.
-DOUBTED = ("( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2"))
+DOUBTED = ("eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2"))
 
 
 def test_an_answer_out_of_time_is_the_greedy_one_and_says_so(finetuned):

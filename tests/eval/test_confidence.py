@@ -26,7 +26,7 @@ def test_the_model_is_sure_of_a_sentence_it_reads_and_doubts_one_it_cannot(trans
     assert answer == "G(!prop_1)"
     assert answer_probability(translator, nl, aps, answer) > 0.8  # 0.90 for the shipped file
     assert answer_probability(translator, nl, aps, "F(prop_1)") < DOUBT
-    nonsense, pair = "( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2")
+    nonsense, pair = "eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2")
     probability = answer_probability(translator, nonsense, pair,
                                      translator.translate(nonsense, pair).stl)
     assert 0 < probability < DOUBT
@@ -72,7 +72,7 @@ def test_decoding_scores_its_answer_on_the_way(translator):
     for nl, aps in [("at no time ( prop_1 )", ("prop_1",)),
                     ("Keep away from the stairs at all times and eventually reach the garden.",
                      ("at_garden", "at_stairs")),
-                    ("( prop_1 ) purple elephant ( prop_2 )", ("prop_1", "prop_2"))]:
+                    ("eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2"))]:
         result = translator.translate(nl, aps)
         assert result.logprob is not None, result.raw  # the tokenizer's own tokens
         scored = translator.score(nl, aps, [parse(result.stl)])[0]
