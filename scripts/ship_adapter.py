@@ -7,9 +7,10 @@
 EXPORT is the recipe's export stage, or a run folder that `ara export --lora-gguf` wrote
 into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT into
 `NAME-peft/`, which `init_adapter: finetuned` reads) beside a record of what produced it
-(the run, the export with its parity, the held-out check) and the parity
-of what a user runs: the embedded Q4_K_M base plus this adapter (llama.cpp) against the
-merged fp32 model (transformers), greedy, on 20 lifted and 20 grounded test pairs. Below
+(the run, the recipe's record of every stage, the export with its parity, the held-out
+check) and the parity of what a user runs: the embedded Q4_K_M base plus this adapter
+(llama.cpp) against the merged fp32 model (transformers), greedy, on 20 lifted and 20
+grounded test pairs. Below
 `--min-agreement` nothing is shipped. Judge the candidate against the shipped file first
 (`scripts/judge_candidate.sh EXPORT/lora.gguf SUITE`): a shipped file is replaced only
 where that judge's `verdict.json` (`runs/generalization/judge-C-S-V/`, named by both
@@ -42,6 +43,22 @@ def export_folders(path: Path) -> tuple[Path, Path]:
             raise ConfigError(f"{path}: no {need.name}; export the run first "
                               "(`ara export --run RUN --quant f16 --lora-gguf`)")
     return run, export
+
+
+def recipe_record(export: Path) -> dict | None:
+    """The record of the staged recipe whose export stage is ``export`` (each stage's
+    fingerprint, steps, wall time and memory), where it exported this very file: a
+    soup's ``run.json`` holds only one part's config, so it cannot say how the file was
+    made."""
+    from ara.provenance import sha256_file
+
+    path = export.parent / "recipe.json"
+    if not path.is_file():
+        return None
+    record = json.loads(path.read_text())
+    files = record.get("stages", {}).get("export", {}).get("result", {}).get("files", {})
+    made = files.get("lora.gguf", {}).get("sha256")
+    return record if made == sha256_file(export / "lora.gguf") else None
 
 
 REPO = Path(__file__).resolve().parents[1]
@@ -113,6 +130,7 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
     heldout = run / "heldout.json"
     manifest = {"file": name, "sha256": sha256_file(target),
                 "run": json.loads((run / "run.json").read_text()),
+                "recipe": recipe_record(export),
                 "export": json.loads((export / "export.json").read_text()),
                 # A soup was never trained as a whole: no held-out check of its own.
                 "heldout": json.loads(heldout.read_text()) if heldout.is_file() else None,

@@ -10,6 +10,8 @@ from ara.eval.translate.request import Request
 from ara.eval.translate.translator import TranslationResult, Translator
 from ara.grammars import parse
 
+from conftest import DOUBTED
+
 #: The keys of `ara translate --json`, in the order translate-file writes them
 #: (Answer.to_json's docstring, docs/evaluation.md).
 DOCUMENTED_KEYS = ["stl", "valid", "raw", "ms", "budget", "error", "model", "constrained",
@@ -87,9 +89,6 @@ def test_repair_defaults_to_on_unless_answers_are_voted_or_unconstrained():
     assert AnswerConfig(constrained=False).repairs == 0
     assert AnswerConfig(repair=RepairConfig(0)).repairs == 0
 
-
-#: A sentence the shipped model doubts its complete answer to: repair draws for it.
-DOUBTED = ("eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2"))
 
 
 def test_an_answer_out_of_time_is_the_greedy_one_and_says_so(finetuned):

@@ -12,6 +12,8 @@ from ara.eval.translate.confidence import (
 )
 from ara.eval.translate.translator import Translator
 
+from conftest import DOUBTED
+
 
 @pytest.fixture(scope="module")
 def translator(finetuned):
@@ -20,15 +22,15 @@ def translator(finetuned):
 
 def test_the_model_is_sure_of_a_sentence_it_reads_and_doubts_one_it_cannot(translator):
     """Tests that the probability of the greedy answer is high for a plain instruction,
-    low for a wrong reading of it, and low for words that say nothing temporal."""
+    low for a wrong reading of it, and low for a garbled request."""
     nl, aps = "at no time ( prop_1 )", ("prop_1",)
     answer = translator.translate(nl, aps).stl
     assert answer == "G(!prop_1)"
     assert answer_probability(translator, nl, aps, answer) > 0.8  # 0.90 for the shipped file
     assert answer_probability(translator, nl, aps, "F(prop_1)") < DOUBT
-    nonsense, pair = "eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2")
-    probability = answer_probability(translator, nonsense, pair,
-                                     translator.translate(nonsense, pair).stl)
+    garbled, pair = DOUBTED
+    probability = answer_probability(translator, garbled, pair,
+                                     translator.translate(garbled, pair).stl)
     assert 0 < probability < DOUBT
     assert answer_probability(translator, nl, aps, None) is None  # no answer, nothing to score
 
@@ -72,7 +74,7 @@ def test_decoding_scores_its_answer_on_the_way(translator):
     for nl, aps in [("at no time ( prop_1 )", ("prop_1",)),
                     ("Keep away from the stairs at all times and eventually reach the garden.",
                      ("at_garden", "at_stairs")),
-                    ("eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2"))]:
+                    DOUBTED]:
         result = translator.translate(nl, aps)
         assert result.logprob is not None, result.raw  # the tokenizer's own tokens
         scored = translator.score(nl, aps, [parse(result.stl)])[0]

@@ -27,7 +27,7 @@ from ara.eval.translate.request import Request
 from ara.eval.translate.translator import TranslationResult, Translator, TranslatorConfig
 from ara.grammars import parse
 
-from conftest import needs_llama
+from conftest import DOUBTED, needs_llama
 
 
 def test_answers_group_by_meaning_not_by_text():
@@ -254,7 +254,7 @@ def test_repair_searches_again_only_where_the_model_doubts_a_complete_answer(fin
     sure = translate_repaired(t, "at no time ( prop_1 )", ("prop_1",),
                               repair=RepairConfig(4))
     assert sure.answers == ("G(!prop_1)",) and math.exp(sure.scores[0]) > 0.9
-    nl, aps = "eventually unless ( prop_1 ) always ( prop_2 )", ("prop_1", "prop_2")
+    nl, aps = DOUBTED
     doubted = translate_repaired(t, nl, aps, repair=RepairConfig(4, doubt=0.5))
     assert len(doubted.answers) == 5 and not gaps(Request.of(nl, aps), parse(doubted.answers[0]))
     assert math.exp(doubted.scores[0]) < 0.5

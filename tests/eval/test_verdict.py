@@ -192,3 +192,23 @@ def test_a_shipped_file_is_replaced_only_as_its_judge_allows(tmp_path):
     failing.write_text(json.dumps(lenient))
     with pytest.raises(ConfigError, match="another rule than the default"):
         ship.judged(candidate, target, failing, None)
+
+
+def test_a_recipe_ship_records_the_recipe_that_exported_that_very_file(tmp_path):
+    """Tests that the shipped file's record keeps the recipe's record of every stage only
+    where its export stage made this file (a rerun since may have exported another)."""
+    ship = shipping_script()
+    export = tmp_path / "recipe" / "export"
+    export.mkdir(parents=True)
+    (export / "lora.gguf").write_bytes(b"adapter")
+    assert ship.recipe_record(export) is None  # an export outside a recipe
+
+    from ara.provenance import sha256_file
+
+    made = {"stages": {"start": {"result": {"steps": 1721}},
+                       "export": {"result": {"files": {"lora.gguf": {
+                           "sha256": sha256_file(export / "lora.gguf")}}}}}}
+    (export.parent / "recipe.json").write_text(json.dumps(made))
+    assert ship.recipe_record(export)["stages"]["start"]["result"]["steps"] == 1721
+    (export / "lora.gguf").write_bytes(b"another run's adapter")
+    assert ship.recipe_record(export) is None
