@@ -80,8 +80,8 @@ def judged(adapter: Path, target: Path, given: Path | None, despite: str | None)
                 f"{registered_version('compositional')}")
     given = given or REPO / "runs" / "generalization" / expected / "verdict.json"
     # A committed record names paths as a clone sees them, not as this checkout lies.
-    shown = (given.resolve().relative_to(REPO) if given.resolve().is_relative_to(REPO)
-             else given)
+    resolved = given.resolve()
+    shown = resolved.relative_to(REPO) if resolved.is_relative_to(REPO) else given
     result, problem = None, None
     if not given.is_file():
         problem = f"no verdict {shown}: judge the candidate first (scripts/judge_candidate.sh)"

@@ -90,7 +90,6 @@ def test_repair_defaults_to_on_unless_answers_are_voted_or_unconstrained():
     assert AnswerConfig(repair=RepairConfig(0)).repairs == 0
 
 
-
 def test_an_answer_out_of_time_is_the_greedy_one_and_says_so(finetuned):
     """Tests that a budget spent before repair can act gives the greedy answer, valid
     and checked for gaps, says it ran out, and counts in ms the whole wait."""
