@@ -105,7 +105,7 @@ from ara.grammars.english import UNITS, Realizer, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
-SYNTHETIC_VERSION = "3.9.0"
+SYNTHETIC_VERSION = "4.0.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
@@ -204,6 +204,11 @@ def _pattern_builders(rng: random.Random, iv: Interval | None, deadline: Interva
         # 3.9: from a moment on for good ("once service is over, keep the fans off from
         # then on"), which the suites write as G(a -> G(b)) and no pattern drew
         lambda: Always(Implies(a, Always(b))),
+        # 4.0: somewhere and there for a while ("hover there for 15 seconds"), and
+        # Dwyer et al.'s precedence ("screw on the cover, but only after connecting the
+        # wires"), which no pattern drew
+        lambda: Eventually(And((a, Always(a, deadline)))),
+        lambda: And((Until(Not(b), a), Eventually(b))),
     ]
 
 
@@ -403,6 +408,11 @@ def roles_of(f: Formula) -> Roles:
               if isinstance(n, (Eventually, Always)) and n.interval is None
               and isinstance(n.arg, Always if isinstance(n, Eventually) else Eventually)
               and n.arg.interval is None and isinstance(n.arg.arg, Atom)}
+    # "go to the dock and stay there for 5 minutes": F(a & G[0,n](a))
+    places |= {n.arg.args[0].name for n in walk(f)
+               if isinstance(n, Eventually) and isinstance(n.arg, And) and len(n.arg.args) == 2
+               and isinstance(n.arg.args[0], Atom) and isinstance(n.arg.args[1], Always)
+               and n.arg.args[1].interval is not None and n.arg.args[1].arg == n.arg.args[0]}
     # What G keeps false, at once or after a condition: "stay out of the kitchen"
     forbidden = set()
     for n in walk(f):

@@ -63,6 +63,37 @@ MORE_OBJECT_VERBS = (
     ("drop", ("drop the {x}", "let go of the {x}")), ("push", ("push the {x}",)),
     ("sort", ("sort the {x}",)), ("weigh", ("weigh the {x}",)),
 )
+#: One-off jobs of many trades, each on things it is done to ("photograph the bridge",
+#: "water the seedlings"): achievements, as `F` asks for them. Before 4.0 the verbs were
+#: a robot's few, and the shipped file read an imperative with a verb it had never seen
+#: ("photograph the valves on tank 2") as a job done again and again (`G(F(.))`).
+TASK_VERBS = (
+    ("photograph", ("photograph the {x}", "take a picture of the {x}"),
+     ("bridge", "fence", "roof", "crack", "meter", "pipes", "panels")),
+    ("wash", ("wash the {x}", "rinse the {x}"), ("windows", "trays", "panels", "floor", "van")),
+    ("water", ("water the {x}",), ("plants", "seedlings", "lawn", "flower_beds")),
+    ("paint", ("paint the {x}", "repaint the {x}"), ("fence", "wall", "railing", "bench")),
+    ("measure", ("measure the {x}", "take a reading of the {x}"),
+     ("pressure", "temperature", "soil", "water_level")),
+    ("label", ("label the {x}", "tag the {x}"), ("boxes", "samples", "bins", "crates")),
+    ("test", ("test the {x}", "run a test on the {x}"), ("alarm", "sensor", "battery", "pump")),
+    ("refill", ("refill the {x}", "top up the {x}"), ("tank", "feeder", "printer", "dispenser")),
+    ("restock", ("restock the {x}",), ("shelves", "fridge", "supply_cart", "minibar")),
+    ("spray", ("spray the {x}",), ("crops", "weeds", "orchard", "hedges")),
+    ("count", ("count the {x}", "take stock of the {x}"), ("boxes", "pallets", "tools", "chairs")),
+    ("sterilize", ("sterilize the {x}", "disinfect the {x}"), ("instruments", "trays", "cart")),
+    ("fold", ("fold the {x}",), ("towels", "laundry", "sheets")),
+    ("tighten", ("tighten the {x}",), ("bolts", "valve", "straps")),
+    ("harvest", ("harvest the {x}",), ("tomatoes", "apples", "lettuce")),
+    ("feed", ("feed the {x}",), ("animals", "fish", "hens")),
+)
+#: One-off jobs done to a place ("vacuum the hallway", "map the warehouse").
+PLACE_TASK_VERBS = (
+    # not vacuum_: a kept state is called vacuum_on
+    ("vacuum_clean", ("vacuum the {x}",)), ("mop", ("mop the {x}", "mop the floor of the {x}")),
+    ("sweep", ("sweep the {x}",)), ("map", ("map the {x}", "make a map of the {x}")),
+    ("survey", ("survey the {x}",)), ("disinfect", ("disinfect the {x}",)),
+)
 DEVICE_VERBS = (
     ("turn_on", ("turn on the {x}", "switch on the {x}", "start the {x}")),
     ("turn_off", ("turn off the {x}", "switch off the {x}", "shut down the {x}")),
@@ -293,11 +324,16 @@ def _draw_condition(rng: random.Random) -> Proposition:
 def _draw_one(rng: random.Random) -> Proposition:
     kind = rng.random()
     if kind < 0.4:
-        verb, phrases = rng.choice(PLACE_VERBS)
+        verbs = PLACE_VERBS if kind < 0.32 else PLACE_TASK_VERBS
+        verb, phrases = rng.choice(verbs)
         name, words = _thing(rng, PLACES, NUMBERED_PLACES)
-    elif kind < 0.7:
-        verb, phrases = rng.choice(OBJECT_VERBS if kind < 0.62 else MORE_OBJECT_VERBS)
+    elif kind < 0.56:
+        verb, phrases = rng.choice(OBJECT_VERBS if kind < 0.5 else MORE_OBJECT_VERBS)
         name, words = _thing(rng, OBJECTS, NUMBERED_OBJECTS)
+    elif kind < 0.7:
+        verb, phrases, things = rng.choice(TASK_VERBS)
+        thing = rng.choice(things)
+        return _about(verb, phrases, thing, thing.replace("_", " "), action=True)
     elif kind < 0.8:
         verb, phrases = rng.choice(DEVICE_VERBS)
         name, words = _thing(rng, DEVICES, NUMBERED_DEVICES)

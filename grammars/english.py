@@ -135,6 +135,21 @@ PHRASES: dict[str, tuple[str, ...]] = {
                  "{a} at some point, and after that {b} at all times",
                  "sooner or later {a}, and from then on {b} holds forever",
                  "eventually {a}; from that point on, always {b}"),
+    # F(a & G[0,n](a)): somewhere, and there for a while ("hover there for 15 seconds").
+    "F_stay_n": ("eventually {a}, and it stays so for {n} {u}",
+                 "at some point {a} and keep it so for the next {n} {u}",
+                 "{a} at some point, and for {n} {u} from then on",
+                 "sooner or later {a}, for at least {n} {u}"),
+    "F_stay_n_place": ("go to {x} and stay there for {n} {u}",
+                       "reach {x} and remain there for {n} {u}",
+                       "get to {x} and wait there for {n} {u}",
+                       "head to {x}, then stay there for {n} {u}",
+                       "go to {x} and hold position there for {n} {u}"),
+    # (!b U a) & F(b): b at some point, never before a (Dwyer et al.'s precedence).
+    "precedence": ("{b}, but only after {a}", "{b}, but not before {a}",
+                   "only after {a}, {b}", "{a}, and only after that {b}",
+                   "{b} at some point, never before {a}",
+                   "{a} first; only then {b}"),
     # (a | b) & !(a & b)
     "xor": ("{a} or {b}, but not both", "either {a} or {b}, but not both",
             "exactly one of {a} and {b}", "{a} or {b}, never both",
@@ -233,6 +248,8 @@ PHRASES: dict[str, tuple[str, ...]] = {
 #: Phrasings only the compositional test split uses; training never sees them.
 HELD_OUT: dict[str, frozenset[str]] = {
     "F": frozenset({"at some moment in the future {a}"}),
+    "F_stay_n_place": frozenset({"head to {x}, then stay there for {n} {u}"}),
+    "precedence": frozenset({"{a} first; only then {b}"}),
     "F_do": frozenset({"you need to {a}"}),
     "F_n": frozenset({"before {n} {u} have passed, {a}"}),
     "F_ab": frozenset({"at some time in the window from {lo} to {hi} {u}, {a}"}),
@@ -538,8 +555,10 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         # "at least once every 6 steps"
         return r.pick("GF_n", used, a=sub(gap.arg), n=gap.interval.hi)
     if isinstance(f, Eventually) and f.interval is not None and f.interval.hi is not None \
-            and _untimed(f.arg, Always) is not None and _timeless(f.arg.arg):
-        # "within 5 steps, the gate is closed for good"
+            and _untimed(f.arg, Always) is not None \
+            and (_timeless(f.arg.arg) or isinstance(f.arg.arg, Until)):
+        # "within 5 steps, the gate is closed for good"; over an until too, since
+        # "within 31 hours, globally a until b" has no word that lasts
         return _timed("FG", f.interval, r, used, allow=_said_first(f.arg.arg),
                       a=sub(f.arg.arg))
     for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
@@ -550,6 +569,21 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             if place is not None:
                 return r.pick(key + "_place", used, x=place)
             return r.pick(key, used, a=sub(inner.arg))
+    stay = _stay(f)
+    if stay is not None:
+        # "fly to waypoint 3 and hover there for 15 seconds"
+        place = _sometimes(stay[0], r.say_place, r)
+        if place is not None:
+            return r.pick("F_stay_n_place", used, x=place, n=stay[1])
+        return r.pick("F_stay_n", used, a=sub(stay[0]), n=stay[1])
+    if _is_precedence(f):
+        # "connect the wires, and only after that screw on the cover"
+        first = f.args[0].rhs
+        # A command goes first ("connect the wires, and only after that ..."), since
+        # "only after connect the wires" is no English
+        command = isinstance(first, Atom) and r.is_action(first.name)
+        return r.pick("precedence", used, allow=lambda p: not command or p.startswith("{a}"),
+                      a=sub(first), b=sub(f.args[1].arg))
     patrol = _patrol(f, r)
     if patrol is not None:
         return r.pick("GF2_place", used, x=patrol[0], y=patrol[1])
@@ -611,6 +645,28 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
     if isinstance(f, Until) and f.interval is None and isinstance(f.lhs, Not):
         return r.pick("avoid_until", used, a=sub(f.lhs.arg), b=sub(f.rhs))
     return None
+
+
+def _stay(f: Formula) -> tuple[Formula, int] | None:
+    """``F(a & G[0,n](a))`` as ``(a, n)``, else ``None``."""
+    inner = _untimed(f, Eventually)
+    if not (isinstance(inner, And) and len(inner.args) == 2):
+        return None
+    head, tail = inner.args
+    if isinstance(tail, Always) and tail.arg == head and tail.interval is not None \
+            and tail.interval.lo == 0 and tail.interval.hi is not None:
+        return head, tail.interval.hi
+    return None
+
+
+def _is_precedence(f: Formula) -> bool:
+    """Whether ``f`` is ``(!b U a) & F(b)``: b at some point, not before a."""
+    if not (isinstance(f, And) and len(f.args) == 2):
+        return False
+    until, later = f.args
+    return (isinstance(until, Until) and until.interval is None and isinstance(until.lhs, Not)
+            and isinstance(later, Eventually) and later.interval is None
+            and later.arg == until.lhs.arg)
 
 
 def _patrol(f: Formula, r: Realizer) -> tuple[str, str] | None:

@@ -24,8 +24,10 @@ from ara.data.vocabulary import (
     LASTING_VERBS,
     MORE_OBJECT_VERBS,
     OBJECT_VERBS,
+    PLACE_TASK_VERBS,
     PLACE_VERBS,
     STANDALONE_ACTIONS,
+    TASK_VERBS,
     kept_states,
 )
 from ara.errors import ConfigError
@@ -96,6 +98,16 @@ def test_three_step_sequences_and_visits_in_any_order_are_drawn(train_records):
     assert any("in that order" in r.nl for r in train_records)
 
 
+def test_a_place_held_for_a_while_and_precedence_are_drawn(train_records):
+    """Tests the patterns 4.0.0 added, alone in some records, each with its idiom in
+    some wording: "go to the dock and stay there for 5 minutes" and "screw on the
+    cover, but only after ..."."""
+    stays = [r for r in train_records if re.fullmatch(r"F\((\w+) & G\[0,\d+\]\(\1\)\)", r.stl)]
+    assert any(r.form == "grounded" and "there for" in r.nl for r in stays)
+    firsts = [r for r in train_records if re.fullmatch(r"\(!(\w+) U \w+\) & F\(\1\)", r.stl)]
+    assert any("only after" in r.nl for r in firsts)
+
+
 def test_patrols_settling_and_exactly_one_of_two_are_drawn(train_records):
     """Tests the patterns 3.3.0 added, each with its idiom in some wording: a place
     reached for good, or again and again, is said as a place."""
@@ -126,8 +138,26 @@ def name_prefixes(verbs) -> tuple[str, ...]:
 
 
 ACTION_PREFIXES = name_prefixes(
-    [verb for verb, _ in PLACE_VERBS + OBJECT_VERBS + MORE_OBJECT_VERBS + DEVICE_VERBS]
-    + sorted(STANDALONE))
+    [verb for verb, _ in PLACE_VERBS + OBJECT_VERBS + MORE_OBJECT_VERBS + DEVICE_VERBS
+     + PLACE_TASK_VERBS] + [verb for verb, _, _ in TASK_VERBS] + sorted(STANDALONE))
+TASK_PREFIXES = name_prefixes([verb for verb, _, _ in TASK_VERBS]
+                              + [verb for verb, _ in PLACE_TASK_VERBS])
+
+
+def test_grounded_rows_ask_for_jobs_of_many_trades(train_records):
+    """Tests that one-off jobs beyond a robot's few verbs ("photograph the bridge",
+    "vacuum the hallway") are in the grounded rows, each where a command may be: never
+    read at the first instant, and mostly asked for at some point."""
+    grounded = [r for r in train_records if r.form == "grounded"]
+    with_task = [r for r in grounded
+                 if any(a.name.startswith(TASK_PREFIXES) for a in walk(r.formula)
+                        if isinstance(a, Atom))]
+    assert len(with_task) > 200
+    verbs = {a.name.split("_")[0] for r in with_task for a in walk(r.formula)
+             if isinstance(a, Atom) and a.name.startswith(TASK_PREFIXES)}
+    assert len(verbs) >= 15  # many trades, not a few verbs drawn over and over
+    said = " ".join(r.nl for r in with_task).lower()
+    assert "photograph the" in said and "vacuum the" in said
 
 
 def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
@@ -219,8 +249,10 @@ def test_what_g_keeps_true_may_be_a_kept_state(train_records):
         text = r.nl.lower()
         for name in {n.name for n in walk(r.formula) if isinstance(n, Atom)} & set(new_names):
             subject, state = new_names[name]
-            if any(w in text for w in (f"keep {subject} {state}", f"leave {subject} {state}",
-                                       f" stay {state}", f" stays {state}")):
+            # "the gate must stay open": the subject's own, since "the microwave stays
+            # off unless the washing machine is off" keeps the microwave alone
+            if any(w in text for w in (f"keep {subject} {state}", f"leave {subject} {state}")) \
+                    or re.search(rf"{subject}( \w+)? stays? {state}", text):
                 said_kept.append(r)
                 assert name in roles_of(r.formula).kept, (r.nl, r.stl)
             elif re.search(rf"{subject} (is|are) {state}", text):
@@ -324,7 +356,8 @@ def test_the_patterns_users_write_are_never_held_out(train_records):
     two-step sequence and the bounded response were once held out by their hash."""
     s = SynthSettings(held_out_percent=50)
     for everyday in ("F(a & F(b))", "G(a -> F[0,30](b))", "F(a & F[0,9](b))",
-                     "F(a & F(G(b)))", "F(a & F(b & F(c)))", "(F(a) & F(b)) & F(c)"):
+                     "F(a & F(G(b)))", "F(a & F(b & F(c)))", "(F(a) & F(b)) & F(c)",
+                     "F(a & G[0,15](a))", "(!b U a) & F(b)"):
         assert shape(parse(everyday)) in pattern_shapes()
         assert not is_held_out(parse(everyday), s)
     assert any(is_held_out(sample_formula(random.Random(i), s, ["a", "b", "c"]), s)

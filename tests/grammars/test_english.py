@@ -42,6 +42,9 @@ from conftest import formulas
         ("G(!a -> b)", "b unless a"),
         ("G(!a -> F(b))", "whenever not a, eventually b"),  # a response, not "unless"
         ("(F(a) | F(b)) & !(F(a) & F(b))", "eventually a or eventually b, but not both"),
+        # somewhere for a while, and a precedence
+        ("F(a & G[0,15](a))", "eventually a, and it stays so for 15 steps"),
+        ("(!b U a) & F(b)", "b, but only after a"),
     ],
 )
 def test_explain_reads_idioms_and_scope(formula, english):
@@ -194,6 +197,25 @@ def test_a_place_is_reached_for_good_or_again_and_again():
     # The words are the first instant's: a bound or a nested G keeps them out
     assert not [s for s in _sayings("F[0,5](G(at_dock))", **words) if "stay there" in s]
     assert explain(parse("F(G(at_dock))")) == "eventually at_dock forever"
+
+
+def test_a_place_held_for_a_while_and_a_step_allowed_only_after_another():
+    """Tests "go to waypoint 3 and stay there for 15 steps" for F(a & G[0,15](a)) over
+    a place, and the precedence (!b U a) & F(b): "screw on the cover, but only after
+    the wires are connected"; a command that must come first is said first, since
+    "only after connect the wires" is no English."""
+    words = {"say_atom": {"at_wp3": "be at waypoint 3", "wires": "the wires are connected",
+                          "connect": "connect the wires",
+                          "cover": "screw on the cover"}.__getitem__,
+             "say_place": {"at_wp3": "waypoint 3"}.get,
+             "is_action": lambda name: name in {"connect", "cover", "at_wp3"}}
+    assert "go to waypoint 3 and stay there for 15 steps" in _sayings(
+        "F(at_wp3 & G[0,15](at_wp3))", **words)
+    assert "screw on the cover, but only after the wires are connected" in _sayings(
+        "(!cover U wires) & F(cover)", **words)
+    first = _sayings("(!cover U connect) & F(cover)", **words)
+    assert "connect the wires, and only after that screw on the cover" in first
+    assert not [s for s in first if "after connect" in s]
 
 
 def test_only_if_and_only_when_follow_a_single_proposition():
