@@ -13,7 +13,9 @@
 # hour). Everything goes to runs/generalization/judge-C-S-V/ (C, S: the candidate's and
 # the shipped file's sha256, 8 digits; V: the registered compositional version), so a
 # rerun after an interruption goes on, and another candidate or data version gets its
-# own folder. DRY_RUN=1 prints the commands instead. It ends with `ara eval verdict`,
+# own folder. The shipped file's greedy answers on the other sets are copied from
+# SHIPPED_ANSWERS (default docs/results/generalization/shipped-greedy) where they are
+# its own on today's data. DRY_RUN=1 prints the commands instead. It ends with `ara eval verdict`,
 # the shipping rule checked set by set into verdict.json, which `scripts/ship_adapter.py`
 # reads; shipped or not, take JUDGE out of WAITING once it has answered.
 set -euo pipefail
@@ -55,7 +57,41 @@ for kind in greedy repair8; do
 done
 step "the other held-out sets, greedy: $others compositional timed"
 eval_sets C 0 "$model" candidate-greedy $others compositional timed
-eval_sets C 0 finetuned shipped-greedy $others compositional timed
+# The shipped file's greedy answers are committed with it (SHIPPED_ANSWERS): a set whose
+# runs there are this very file's, on the data version registered now and with the
+# judge's settings, is copied rather than asked again (half an hour on 2 cores).
+asked=$($py - "$shipped" "${SHIPPED_ANSWERS:-docs/results/generalization/shipped-greedy}" \
+  "runs/generalization/$root/shipped-greedy" "${DRY_RUN:-}" $others compositional timed <<'PY'
+import hashlib, json, shutil, sys
+from pathlib import Path
+from ara.data import registered_version
+shipped, saved, out, dry, *sets = sys.argv[1:]
+lora = "+lora:sha256:" + hashlib.sha256(Path(shipped).read_bytes()).hexdigest()[:16]
+asked = []
+for split in sets:
+    forms = ("lifted",) if split == "timed" else ("lifted", "grounded")
+    runs = [Path(saved) / f"{split}-{form}" for form in forms]
+    metas = [json.loads((r / "run.json").read_text()) for r in runs
+             if (r / "run.json").is_file() and (r / "samples.jsonl").is_file()]
+    if len(metas) < len(forms) or not all(
+            m["model_id"].endswith(lora) and m["data"]["version"] == registered_version(split)
+            and m["config"]["variants"] == ["C"] and not m["config"].get("repair")
+            and m["config"]["shots"] == [5] and m["config"]["limit"] == (100 if split == "timed" else 200)
+            for m in metas):
+        asked.append(split)
+        continue
+    for run, meta in zip(runs, metas):
+        copy = Path(out) / run.name
+        print(f"{'would copy' if dry else 'copied'} {run} to {copy}", file=sys.stderr)
+        if dry or copy.exists():
+            continue
+        shutil.copytree(run, copy)
+        meta["config"]["model"] = "finetuned"  # what a rerun here would ask for: it resumes
+        (copy / "run.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+print(*asked)
+PY
+)
+[ -z "$asked" ] || eval_sets C 0 finetuned shipped-greedy $asked
 run $py scripts/generalization_table.py --results "runs/generalization/$root" \
   --models shipped-greedy,candidate-greedy
 step "the help request, candidate and shipped"

@@ -52,3 +52,32 @@ def test_a_missing_candidate_is_named(tmp_path):
     done = judge(str(tmp_path / "lora.gguf"), "handwritten11")
     assert done.returncode == 2 and f"no file {tmp_path / 'lora.gguf'}" in done.stderr
     assert judge().returncode != 0  # and the usage line without arguments
+
+
+def test_the_shipped_files_committed_answers_are_copied_only_where_they_are_its_own(tmp_path):
+    """Tests that the shipped file's greedy answers on the other sets come from
+    SHIPPED_ANSWERS where a run there is this very file's, on today's data version and
+    the judge's settings, and that a set whose runs are another file's is asked again."""
+    import json
+    import shutil
+
+    saved = Path(__file__).parents[1] / "docs" / "results" / "generalization" / "shipped-greedy"
+    answers = tmp_path / "answers"
+    for form in ("lifted", "grounded"):
+        shutil.copytree(saved / f"handwritten4-{form}", answers / f"handwritten4-{form}")
+        other = shutil.copytree(saved / f"handwritten5-{form}", answers / f"handwritten5-{form}")
+        meta = json.loads((other / "run.json").read_text())
+        meta["model_id"] = meta["model_id"].rsplit(":", 1)[0] + ":0123456789abcdef"
+        (other / "run.json").write_text(json.dumps(meta))
+    candidate = tmp_path / "lora.gguf"
+    candidate.write_bytes(b"")
+    done = judge(str(candidate), "handwritten11", DRY_RUN="1", PAPER="0",
+                 SHIPPED_ANSWERS=str(answers))
+    assert done.returncode == 0, done.stderr
+    copied = [line for line in done.stderr.splitlines() if line.startswith("would copy")]
+    assert sorted(line.split()[2].rsplit("/", 1)[1] for line in copied) == [
+        "handwritten4-grounded", "handwritten4-lifted"]
+    shipped = next(line for line in done.stdout.splitlines()
+                   if "finetuned" in line and "shipped-greedy handwritten" in line
+                   and "handwritten11" not in line)
+    assert "handwritten5" in shipped and "handwritten4 " not in shipped
