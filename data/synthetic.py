@@ -101,7 +101,7 @@ from ara.grammars.ast import (
     rename_atoms,
     walk,
 )
-from ara.grammars.english import UNITS, Realizer, realize
+from ara.grammars.english import UNITS, Realizer, held_for, realize
 from ara.grammars.printer import to_text
 from ara.grammars.syntax import Syntax
 
@@ -204,9 +204,9 @@ def _pattern_builders(rng: random.Random, iv: Interval | None, deadline: Interva
         # 3.9: from a moment on for good ("once service is over, keep the fans off from
         # then on"), which the suites write as G(a -> G(b)) and no pattern drew
         lambda: Always(Implies(a, Always(b))),
-        # 4.0: somewhere and there for a while ("hover there for 15 seconds"), and
-        # Dwyer et al.'s precedence ("screw on the cover, but only after connecting the
-        # wires"), which no pattern drew
+        # 4.0: a state reached and kept a while ("hover there for 15 seconds"), and
+        # Dwyer et al.'s precedence with b required ("connect the wires, and only after
+        # that screw on the cover"), which no pattern drew
         lambda: Eventually(And((a, Always(a, deadline)))),
         lambda: And((Until(Not(b), a), Eventually(b))),
     ]
@@ -380,7 +380,8 @@ def roles_of(f: Formula) -> Roles:
 
     Conditions: the propositions read at the first instant, and those read at the
     instant of an antecedent or of an equivalence (``a`` in ``G(a -> b)``). States:
-    those read at the instant of a consequent (``b`` in ``G(a -> b)``), which a lasting
+    those read at the instant of a consequent (``b`` in ``G(a -> b)``) or reached and kept
+    a while (``a`` in ``F(a & G[0,n](a))``), which a lasting
     action may be ("whenever the alarm is on, wait") but an achievement may not: a
     user's "whenever the light is green, put down the book" asks for
     ``G(light_green -> F(place_book))``, which the response idiom words that way, and
@@ -408,11 +409,11 @@ def roles_of(f: Formula) -> Roles:
               if isinstance(n, (Eventually, Always)) and n.interval is None
               and isinstance(n.arg, Always if isinstance(n, Eventually) else Eventually)
               and n.arg.interval is None and isinstance(n.arg.arg, Atom)}
-    # "go to the dock and stay there for 5 minutes": F(a & G[0,n](a))
-    places |= {n.arg.args[0].name for n in walk(f)
-               if isinstance(n, Eventually) and isinstance(n.arg, And) and len(n.arg.args) == 2
-               and isinstance(n.arg.args[0], Atom) and isinstance(n.arg.args[1], Always)
-               and n.arg.args[1].interval is not None and n.arg.args[1].arg == n.arg.args[0]}
+    # What is reached and kept a while, F(a & G[0,n](a)), can last: a condition, or a
+    # lasting action such as being somewhere ("go to the dock and stay there for 5
+    # minutes"), never a one-off job ("tag the boxes for 15 hours")
+    states |= {held[0].name for n in walk(f) if (held := held_for(n)) is not None
+               and isinstance(held[0], Atom)}
     # What G keeps false, at once or after a condition: "stay out of the kitchen"
     forbidden = set()
     for n in walk(f):

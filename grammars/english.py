@@ -104,13 +104,15 @@ PHRASES: dict[str, tuple[str, ...]] = {
     "FG_n": ("within {n} {u}, {a} for good", "{a} within {n} {u}, and from then on forever",
              "no later than {s} {n}, {a}, and it stays so from then on",
              "in the next {n} {u}, {a} from some point on, forever",
-             "{a} within the next {n} {u} and permanently after that"),
+             "{a} within the next {n} {u} and permanently after that",
+             "within {n} {u}, {a}, and from then on that holds for good"),
     "FG_ab": ("at some point between {s} {lo} and {s} {hi}, {a} for good",
               "{a} between {lo} and {hi} {u} from now, and from then on forever",
               "no sooner than {s} {lo} and no later than {s} {hi}, {a}, and it stays so "
               "from then on",
               "within {lo} to {hi} {u}, {a} permanently",
-              "after {lo} {u} but no later than {hi} {u}, {a} for good"),
+              "after {lo} {u} but no later than {hi} {u}, {a} for good",
+              "between {lo} and {hi} {u} from now, {a}, and from then on that holds for good"),
     # F(G(a)) and G(F(a)) over a place: where the robot ends up, where it keeps going.
     "FG_place": ("go to {x} and stay there", "reach {x} and remain there",
                  "get to {x} and stay there for good", "head to {x} and remain there forever",
@@ -135,21 +137,27 @@ PHRASES: dict[str, tuple[str, ...]] = {
                  "{a} at some point, and after that {b} at all times",
                  "sooner or later {a}, and from then on {b} holds forever",
                  "eventually {a}; from that point on, always {b}"),
-    # F(a & G[0,n](a)): somewhere, and there for a while ("hover there for 15 seconds").
+    # F(a & G[0,n](a)): a state reached and kept a while, said of a condition, of a
+    # lasting action ("hold the box for 5 minutes at some point") or of a place ("fly to
+    # waypoint 3 and hover there for 15 seconds").
     "F_stay_n": ("eventually {a}, and it stays so for {n} {u}",
-                 "at some point {a} and keep it so for the next {n} {u}",
+                 "at some point {a}, and that holds for the next {n} {u}",
                  "{a} at some point, and for {n} {u} from then on",
                  "sooner or later {a}, for at least {n} {u}"),
+    "F_stay_n_do": ("{a} for {n} {u} at some point", "at some point {a}, and keep doing so "
+                    "for {n} {u}", "sooner or later {a} for {n} {u} straight",
+                    "{a} for at least {n} {u} at some point"),
     "F_stay_n_place": ("go to {x} and stay there for {n} {u}",
                        "reach {x} and remain there for {n} {u}",
                        "get to {x} and wait there for {n} {u}",
                        "head to {x}, then stay there for {n} {u}",
                        "go to {x} and hold position there for {n} {u}"),
-    # (!b U a) & F(b): b at some point, never before a (Dwyer et al.'s precedence).
+    # (!b U a) & F(b): b at some point, never before a (Dwyer et al.'s precedence,
+    # !b W a, with b required to happen).
     "precedence": ("{b}, but only after {a}", "{b}, but not before {a}",
                    "only after {a}, {b}", "{a}, and only after that {b}",
                    "{b} at some point, never before {a}",
-                   "{a} first; only then {b}"),
+                   "{a} first; only then {b}", "first {a}, and only then {b}"),
     # (a | b) & !(a & b)
     "xor": ("{a} or {b}, but not both", "either {a} or {b}, but not both",
             "exactly one of {a} and {b}", "{a} or {b}, never both",
@@ -559,8 +567,11 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             and (_timeless(f.arg.arg) or isinstance(f.arg.arg, Until)):
         # "within 5 steps, the gate is closed for good"; over an until too, since
         # "within 31 hours, globally a until b" has no word that lasts
-        return _timed("FG", f.interval, r, used, allow=_said_first(f.arg.arg),
-                      a=sub(f.arg.arg))
+        kept = f.arg.arg
+        # An until is set off by commas: "within 31 hours, a until b for good" reads as
+        # a U G(b), and "a until b within 31 hours, ..." as a bounded until
+        allow = (lambda p: ", {a}, and" in p) if isinstance(kept, Until) else _said_first(kept)
+        return _timed("FG", f.interval, r, used, allow=allow, a=sub(kept))
     for outer, nested, key in ((Eventually, Always, "FG"), (Always, Eventually, "GF")):
         inner = _untimed(f, outer)
         if inner is not None and _untimed(inner, nested) is not None:
@@ -569,21 +580,25 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
             if place is not None:
                 return r.pick(key + "_place", used, x=place)
             return r.pick(key, used, a=sub(inner.arg))
-    stay = _stay(f)
+    stay = held_for(f)
     if stay is not None:
         # "fly to waypoint 3 and hover there for 15 seconds"
-        place = _sometimes(stay[0], r.say_place, r)
+        kept, n = stay
+        place = _sometimes(kept, r.say_place, r)
         if place is not None:
-            return r.pick("F_stay_n_place", used, x=place, n=stay[1])
-        return r.pick("F_stay_n", used, a=sub(stay[0]), n=stay[1])
+            return r.pick("F_stay_n_place", used, x=place, n=n)
+        command = isinstance(kept, Atom) and r.is_action(kept.name)
+        return r.pick("F_stay_n_do" if command else "F_stay_n", used, a=sub(kept), n=n)
     if _is_precedence(f):
         # "connect the wires, and only after that screw on the cover"
         first = f.args[0].rhs
-        # A command goes first ("connect the wires, and only after that ..."), since
-        # "only after connect the wires" is no English
-        command = isinstance(first, Atom) and r.is_action(first.name)
-        return r.pick("precedence", used, allow=lambda p: not command or p.startswith("{a}"),
-                      a=sub(first), b=sub(f.args[1].arg))
+        # A command is not said after "after" or "before" ("only after connect the
+        # wires" is no English): "connect the wires, and only after that ..."
+        command = any(isinstance(g, Atom) and r.is_action(g.name) for g in walk(first))
+        # and only a command comes "first" ("first the light is red" is no order)
+        return r.pick("precedence", used, allow=lambda p: (
+            not ("after {a}" in p or "before {a}" in p) if command else "first" not in p),
+            a=sub(first), b=sub(f.args[1].arg))
     patrol = _patrol(f, r)
     if patrol is not None:
         return r.pick("GF2_place", used, x=patrol[0], y=patrol[1])
@@ -647,8 +662,8 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
     return None
 
 
-def _stay(f: Formula) -> tuple[Formula, int] | None:
-    """``F(a & G[0,n](a))`` as ``(a, n)``, else ``None``."""
+def held_for(f: Formula) -> tuple[Formula, int] | None:
+    """``F(a & G[0,n](a))`` (a reached, and kept for ``n``) as ``(a, n)``, else ``None``."""
     inner = _untimed(f, Eventually)
     if not (isinstance(inner, And) and len(inner.args) == 2):
         return None

@@ -147,17 +147,19 @@ TASK_PREFIXES = name_prefixes([verb for verb, _, _ in TASK_VERBS]
 def test_grounded_rows_ask_for_jobs_of_many_trades(train_records):
     """Tests that one-off jobs beyond a robot's few verbs ("photograph the bridge",
     "vacuum the hallway") are in the grounded rows, each where a command may be: never
-    read at the first instant, and mostly asked for at some point."""
+    read at the first instant, where a condition is."""
     grounded = [r for r in train_records if r.form == "grounded"]
     with_task = [r for r in grounded
                  if any(a.name.startswith(TASK_PREFIXES) for a in walk(r.formula)
                         if isinstance(a, Atom))]
-    assert len(with_task) > 200
+    assert len(with_task) > 150  # about one row in three
     verbs = {a.name.split("_")[0] for r in with_task for a in walk(r.formula)
              if isinstance(a, Atom) and a.name.startswith(TASK_PREFIXES)}
     assert len(verbs) >= 15  # many trades, not a few verbs drawn over and over
     said = " ".join(r.nl for r in with_task).lower()
     assert "photograph the" in said and "vacuum the" in said
+    assert not [r for r in with_task if any(
+        name.startswith(TASK_PREFIXES) for name in atoms_read_now(r.formula))]
 
 
 def test_grounded_rows_read_only_conditions_at_the_first_instant(train_records):
@@ -289,7 +291,7 @@ def test_a_rule_said_with_if_or_when_holds_at_all_times(train_records):
         r.nl for r in now_rules if not first_instant.search(r.nl)][:3]
     standing = [r for r in grounded if isinstance(r.formula, Always)
                 and re.match(r"(if|when) (?!ever\b)", r.nl.lower())]
-    assert len(standing) >= 10, [r.nl for r in standing]
+    assert len(standing) >= 5, [r.nl for r in standing]
     once = [r for r in grounded if isinstance(r.formula, Always)
             and isinstance(r.formula.arg, Implies) and isinstance(r.formula.arg.rhs, Always)]
     assert once and [r for r in once if re.search(r"\b(once|from then on|again)\b", r.nl)]

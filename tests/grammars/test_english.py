@@ -42,9 +42,12 @@ from conftest import formulas
         ("G(!a -> b)", "b unless a"),
         ("G(!a -> F(b))", "whenever not a, eventually b"),  # a response, not "unless"
         ("(F(a) | F(b)) & !(F(a) & F(b))", "eventually a or eventually b, but not both"),
-        # somewhere for a while, and a precedence
+        # a state reached and kept a while
         ("F(a & G[0,15](a))", "eventually a, and it stays so for 15 steps"),
+        # a precedence: b required, never before a
         ("(!b U a) & F(b)", "b, but only after a"),
+        # a bounded F over an until: commas keep "for good" off b
+        ("F[0,31](G(a U b))", "no later than step 31, a until b, and it stays so from then on"),
     ],
 )
 def test_explain_reads_idioms_and_scope(formula, english):
@@ -199,23 +202,32 @@ def test_a_place_is_reached_for_good_or_again_and_again():
     assert explain(parse("F(G(at_dock))")) == "eventually at_dock forever"
 
 
-def test_a_place_held_for_a_while_and_a_step_allowed_only_after_another():
-    """Tests "go to waypoint 3 and stay there for 15 steps" for F(a & G[0,15](a)) over
-    a place, and the precedence (!b U a) & F(b): "screw on the cover, but only after
-    the wires are connected"; a command that must come first is said first, since
-    "only after connect the wires" is no English."""
+def test_a_state_kept_a_while_and_a_step_allowed_only_after_another():
+    """Tests F(a & G[0,15](a)): "go to waypoint 3 and stay there for 15 steps" over a
+    place, "hold the box for 15 steps at some point" over a lasting action, never "hold
+    the box, and it stays so" (a command is no state); and the precedence
+    (!b U a) & F(b): "screw on the cover, but only after the wires are connected", with
+    a command that must come first said first, since "only after connect the wires" is
+    no English, and only a command coming "first"."""
     words = {"say_atom": {"at_wp3": "be at waypoint 3", "wires": "the wires are connected",
-                          "connect": "connect the wires",
+                          "connect": "connect the wires", "hold": "hold the box",
                           "cover": "screw on the cover"}.__getitem__,
              "say_place": {"at_wp3": "waypoint 3"}.get,
-             "is_action": lambda name: name in {"connect", "cover", "at_wp3"}}
+             "is_action": lambda name: name in {"connect", "cover", "at_wp3", "hold"}}
     assert "go to waypoint 3 and stay there for 15 steps" in _sayings(
         "F(at_wp3 & G[0,15](at_wp3))", **words)
-    assert "screw on the cover, but only after the wires are connected" in _sayings(
-        "(!cover U wires) & F(cover)", **words)
-    first = _sayings("(!cover U connect) & F(cover)", **words)
-    assert "connect the wires, and only after that screw on the cover" in first
-    assert not [s for s in first if "after connect" in s]
+    held = _sayings("F(hold & G[0,15](hold))", **words)
+    assert "hold the box for 15 steps at some point" in held
+    assert not [s for s in held if "stays so" in s or "holds" in s or "from then on" in s]
+    after = _sayings("(!cover U wires) & F(cover)", **words)
+    assert "screw on the cover, but only after the wires are connected" in after
+    assert not [s for s in after if s.startswith("first")]
+    for first in ("connect", "!connect", "connect | wires"):
+        said = _sayings(f"(!cover U ({first})) & F(cover)", **words)
+        assert said and not [s for s in said if "after connect" in s or "after do not" in s
+                             or "before connect" in s], first
+    assert "connect the wires, and only after that screw on the cover" in _sayings(
+        "(!cover U connect) & F(cover)", **words)
 
 
 def test_only_if_and_only_when_follow_a_single_proposition():
