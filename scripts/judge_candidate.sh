@@ -62,11 +62,12 @@ eval_sets C 0 "$model" candidate-greedy $others compositional timed
 # judge's settings, is copied rather than asked again (half an hour on 2 cores).
 asked=$($py - "$shipped" "${SHIPPED_ANSWERS:-docs/results/generalization/shipped-greedy}" \
   "runs/generalization/$root/shipped-greedy" "${DRY_RUN:-}" $others compositional timed <<'PY'
-import hashlib, json, shutil, sys
+import json, shutil, sys
 from pathlib import Path
 from ara.data import registered_version
+from ara.eval.translate.backends.llama_cpp_backend import lora_id
 shipped, saved, out, dry, *sets = sys.argv[1:]
-lora = "+lora:sha256:" + hashlib.sha256(Path(shipped).read_bytes()).hexdigest()[:16]
+lora = lora_id(shipped)
 asked = []
 for split in sets:
     forms = ("lifted",) if split == "timed" else ("lifted", "grounded")

@@ -38,6 +38,12 @@ from ara.provenance import sha256_file
 
 MASK_ENGINES = ("llguidance", "llama")
 
+
+def lora_id(lora_path: str | Path) -> str:
+    """What a LoRA adds to a run's ``model_id``: its file's hash, so a run's record names
+    the very adapter that answered."""
+    return f"+lora:sha256:{sha256_file(lora_path)[:16]}"
+
 #: Prompt positions are fed in chunks starting at multiples of this; whole chunks are
 #: the unit of reuse. Larger reuses less of a shared prefix, smaller feeds more batches.
 CHUNK = 64
@@ -83,7 +89,7 @@ class LlamaCppBackend:
         self.mask = mask
         self.model_id = f"gguf:{Path(model_path).name}:sha256:{sha256_file(model_path)[:16]}"
         if lora_path:
-            self.model_id += f"+lora:sha256:{sha256_file(lora_path)[:16]}"
+            self.model_id += lora_id(lora_path)
         self._vocab = llama_cpp.llama_model_get_vocab(self.llm._model.model)
         self._eos = {self.llm.token_eos(), *self._end_of_turn()}
         self._lltokenizer = None
