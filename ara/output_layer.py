@@ -2,8 +2,8 @@
 
 Gemma's output layer (262k words x hidden) costs more than the rest of a 270M model.
 Given the usual ``(batch, tokens, hidden)`` input, its product is a batched one, which
-in bf16 on a CPU first copies the whole transposed layer: more than a third of a
-training step, and about 30% of a bf16 answer's time (``bench/hf_generation_head.py``).
+in bf16 on a CPU first copies the whole transposed layer (``bench/hf_generation_head.py``
+measures what that costs; docs/benchmarks.md).
 Training and the transformers backend both hand it the two-dimensional rows they need,
 each with its own ``pick``, while the model's own forward still runs (so wrappers such
 as peft and DDP see the call).

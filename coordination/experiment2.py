@@ -1,6 +1,6 @@
 """The paper's Experiment 2: who should move the pallet, and what does it cost?
 
-Per trial (``../shared/specs/experiment2.md``; seeds 3000..3099, drawn as the
+Per trial (``docs/experiment2-spec.md``; seeds 3000..3099, drawn as the
 authors' code draws them by default, see :mod:`ara.coordination.trials`): an 8x8 grid,
 a help site, 6 forklifts, 12 pick-and-place jobs, a makespan cap of 50. The exact
 Oracle schedules the 12 jobs once (S_orig); then each method places the help job and

@@ -14,7 +14,7 @@ Two ways to draw trial ``s`` (a seed; the paper's run uses 3000..3099):
      pick may equal its drop.
 
   Written from this recipe alone, the draw matched the authors' site, starts and jobs
-  in 100 of 100 trials (see ``../shared/specs/experiment2.md``).
+  in 100 of 100 trials (see ``docs/experiment2-spec.md``).
 * ``uniform`` draws the same distribution from one unbroken stream (site, then
   starts, then each job's pick and drop): this project's generator before the recipe
   above was known.

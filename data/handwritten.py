@@ -1,41 +1,11 @@
 """The hand-written suites: instructions written for this project as a user would, each
 with its reference and the readings it must not be confused with. Test only: no
-training mixture includes them.
+training mixture includes them, and mixtures drop any record that says one.
 
-``handwritten/suite.yaml`` (split ``handwritten``, 164 entries) guided the synthetic
-generator's later versions through its misses; ``handwritten/suite2.yaml`` (split
-``handwritten2``, 109 entries) was written after that and never guided data, but its
-misses, with the first suite's, guided which slips repair checks for;
-``handwritten/suite3.yaml`` (split ``handwritten3``, 65 entries) was written after those
-checks and is their blind measure; ``handwritten/suite4.yaml`` (split ``handwritten4``,
-167 entries, in domains no earlier suite covers: household robots, drones, hospital
-logistics, manufacturing cells, agriculture) was written blind on 2026-11-26, before any
-model answered it or any change it judges; its misses later guided generator 3.7;
-``handwritten/suite5.yaml`` (split ``handwritten5``, 134 entries, in domains no earlier
-suite covers: restaurant kitchens, construction sites, lab automation, ports and ships,
-planetary rovers) was written blind on 2026-11-26 by the same rules, before any model
-answered it, and is never read to guide anything; ``handwritten/suite6.yaml``
-(split ``handwritten6``, 138 entries: retail, mining, marine inspection, airport ground
-operations, security patrol) was written blind on 2026-11-27 by the same rules;
-``handwritten/suite7.yaml`` (split ``handwritten7``, 147 entries: solar and wind farm
-maintenance, rail yards, hotel service robots, sidewalk parcel delivery, wildfire and
-forestry) was written blind on 2026-11-27 by the same rules and judged the recipe's run
-on generator 3.9 (2026-11-27/28); ``handwritten/suite8.yaml``
-(split ``handwritten8``, 148 entries: fish farms, libraries and archives, event venues
-and stadiums, water treatment plants, snow clearing) was written blind on 2026-11-27 by
-the same rules; it judged repair's window check (``G[a,b](F)``) that day;
-``handwritten/suite9.yaml`` (split ``handwritten9``,
-149 entries: data centers and server rooms, film and TV sets, car washes and vehicle
-service bays, zoos and animal care, recycling and waste sorting plants) was written blind
-on 2026-11-27 by the same rules; it judged repair's condition check that day;
-``handwritten/suite10.yaml`` (split ``handwritten10``, 163 entries: elder care and
-nursing homes, electrical substations and power lines, theme parks and rides, laundries
-and textile plants, bridge and tunnel inspection) was written blind on 2026-11-27 by the
-same rules, to judge the change after that check, and kept for the recipe's third run,
-which it judged on 2026-11-28; ``handwritten/suite11.yaml`` (split ``handwritten11``, 165 entries:
-ski resorts, museums and galleries, breweries and wineries, swimming pools and aquatic
-centers, parking garages and car parks) was written blind on 2026-11-28 by the same
-rules, to judge the change after the recipe's third run.
+``handwritten/suite.yaml`` is the split ``handwritten``, ``suiteN.yaml`` the split
+``handwrittenN``. Which suites are blind, when each was written and what each judged is
+in docs/data.md ("The hand-written suites"); a suite waiting for the change it is to
+judge is in ``WAITING``.
 """
 
 from __future__ import annotations
@@ -71,18 +41,8 @@ class SuiteEntry:
         nl: The instruction.
         stl: Its reference formula, canonical.
         confusions: Readings a translator could plausibly give instead (canonical).
-        domain: ``lifted``, ``navigation``, ``manipulation`` or ``warehouse`` (the first
-            three suites); ``lifted``, ``household``, ``drones``, ``hospital``,
-            ``manufacturing`` or ``agriculture`` (the fourth); ``lifted``,
-            ``restaurant``, ``construction``, ``lab``, ``port`` or ``rover`` (the fifth);
-            ``lifted``, ``retail``, ``mining``, ``marine``, ``airport`` or ``security``
-            (the sixth); ``lifted``, ``energy``, ``rail``, ``hotel``, ``delivery`` or
-            ``forestry`` (the seventh); ``lifted``, ``aquaculture``, ``library``,
-            ``venue``, ``water`` or ``snow`` (the eighth); ``lifted``, ``datacenter``,
-            ``film``, ``carwash``, ``zoo`` or ``recycling`` (the ninth); ``lifted``,
-            ``eldercare``, ``substation``, ``themepark``, ``laundry`` or ``bridge``
-            (the tenth); ``lifted``, ``ski``, ``museum``, ``brewery``, ``pool`` or
-            ``parking`` (the eleventh).
+        domain: ``lifted``, or the application the sentence comes from (``warehouse``,
+            ``hospital``, ``ski``, ...; each suite's own in its file).
     """
 
     nl: str

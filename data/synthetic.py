@@ -4,13 +4,14 @@ worded by the English realizer (:mod:`ara.grammars.english`).
 Most formulas are what users write: 40% one pattern (reach, avoid, two- and
 three-step sequence, visits in any order, response, recurrence, persistence, bounded
 reach and avoid, until, patrolling, a moment and what holds from then on, exactly one
-of two), 30% two patterns joined by a connective, 15% three patterns
-that must all hold, each as deep as the decoding grammar allows (5); the other 15% grow
-at random over every operator of the grammar (``!``, ``&``, ``|``, ``->``, ``<->``,
-``F``, ``G``, ``U``, each temporal one timed or not) up to depth 4. A pattern's operand is now
-and then a small Boolean formula ("both a and b", "a or b", "not a"), so that scope is
-learned. A formula has 1 to 5 propositions, and one may occur twice. Each row is worded
-twice: lifted (``prop_1``...) and grounded (``go_to_kitchen``...).
+of two, a state reached and held a while, precedence), 30% two patterns joined by a
+connective, 15% three patterns that must all hold, each as deep as the decoding grammar
+allows (5); the other 15% grow at random over every operator of the grammar (``!``,
+``&``, ``|``, ``->``, ``<->``, ``F``, ``G``, ``U``, each temporal one timed or not) up to
+depth 4. A pattern's operand is now and then a small Boolean formula ("both a and b",
+"a or b", "not a"), so that scope is learned. A formula has 1 to 5 propositions, and one
+may occur twice. Each row is worded twice: lifted (``prop_1``...) and grounded
+(``go_to_kitchen``...).
 
 In grounded form a proposition read at the first instant only (``a`` in ``a -> F(b)``),
 or at the instant of an antecedent (``a`` in ``G(a -> b)``), is a condition ("the door
@@ -21,48 +22,8 @@ on its own ("go to the kitchen") means *at some point*, and is written
 ``G(a -> ...)`` with ``a`` alone: there an achievement may be said as an event
 ("whenever you pick up the red box, ...").
 
-Version 3 (after reading the shipped fine-tune's misses, docs/what-moved.md) draws
-three-step sequences, which version 2's depth limit of 4 had silently rejected, says
-conditions or lasting actions where version 2 said any command around "whenever", and
-adds the visit pattern and "in that order" / "in any order". Version 3.1 brings back
-actions as triggers, said as events (3.0 left none, and the fine-tune on it wrote
-``F(pick -> F(place))`` for the help request), and "stop" as a lasting action.
-Version 3.2 (after the misses every 3.1 fine-tune shared on the first hand-written
-suite) says a Boolean operand over propositions plainly too ("always a or b" is
-``G(a | b)``, so ``G(a) | b`` is said "always a, or b"), has words for a place's
-negation ("stay out of the kitchen"), draws ``G(a -> !b)`` as a pattern of its own,
-and adds wordings of bounded reach ("at least once in the next 10 steps") and of
-avoidance until a goal ("reach b, but do not a before that"). Version 3.3 adds the
-idioms users reach for that no earlier version said: being somewhere for good or again
-and again ("go to the dock and stay there" ``F(G(at_dock))``, "keep coming back to the
-dock" ``G(F(at_dock))``, "patrol between a and b"), "a, and from then on always b"
-(``F(a & G(b))``), "a or b, but not both", "a only if b" / "a only when b" and "never
-a and b at the same time"; patrolling, ``F(a & G(b))`` and exactly-one-of are patterns
-of their own. Version 3.4 (after v11's misses on the first suite that 3.3 left)
-says what an action may not do while a condition holds ("never touch the pan while
-the stove is on", ``G(stove_on -> !touch_pan)``), where any action, an achievement
-too, may be forbidden; says a response to a command as the bare command ("whenever
-the battery is low, go to the charging station") in 70% of such sentences, not half;
-and draws responses, three-step sequences and visits of three in any order twice as
-often as before. Version 3.5 widens the grounded vocabulary (:mod:`ara.data.vocabulary`):
-devices and what is done to them ("turn off the fan", "close the valve"), more object
-verbs ("load", "scan", "drop") and standalone actions ("return to base"), and conditions whose
-words sound negative ("the lights are off", "the tank is empty"), so that a name with
-"off", "low" or "empty" in it is read as the proposition it is, not as its negation.
-Version 3.6 stops holding out the patterns' own shapes (see :func:`pattern_shapes`:
-the hash had taken the two-step sequence and the bounded response out of training),
-and adds a step with a deadline after the one before (``F(a & F[0,n](b))``) and a last
-step that is somewhere for good (``F(a & F(G(b)))``). Version 3.7 (after the fourth
-hand-written suite's misses) draws a recurrence with a longest gap (``G(F[0,n](a))``, "at
-least once every 6 hours") and what holds unless a condition does (``G(!a -> b)``, "keep
-the gate closed unless a truck is waiting"), and says a window as "no sooner than 4 and
-no later than 9". Version 3.8 says a moment by a deadline from which something holds for
-good (``F[0,n](G(a))``) with words that last ("within 5 steps, the gate is closed for
-good"), not "within 5 steps, globally a", which repair's checks read as asking for no
-``F(G)``; counts time in minutes and hours too ("no sooner than minute 20", "within 2
-hours"), as users do, where earlier versions said only steps, time units and seconds;
-and says a window after the action as well ("dust the shelf no sooner than minute 20
-and no later than minute 50").
+What each version of the generator added, and why, is in docs/data.md ("Versions of
+the mixture"); ``SYNTHETIC_VERSION`` names this one.
 
 The compositional test split holds out *shapes* (a formula with its propositions
 renamed in order and its bounds blanked, with at least three operators, other than

@@ -22,8 +22,8 @@ measured: an interrupted run cannot pass. The folder's layout is the judge's:
 ``{shipped,candidate}-{greedy,repair8}/<set>-<form>/samples.jsonl``,
 ``help-request-wordings{,-shipped}.json`` and ``exp2-candidate/summary.json``; folders
 named ``<set>-<form>@<version>`` hold runs on an earlier data version and are not read.
-The paper split, which 97% overlaps training, is measured by the judge for the candidate
-alone and not checked here.
+The paper split, whose test sentences are nearly all in training, is measured by the
+judge for the candidate alone and not checked here.
 """
 
 from __future__ import annotations

@@ -86,7 +86,7 @@ def doubt_warning(stl: str, probability: float,
     ``others``' readings under it (formula, probability), as
     :func:`~ara.eval.translate.repair.readings` gives them after the winner."""
     lines = [f"note: the model gives this answer a probability of {probability:.2g}; below "
-             f"{DOUBT:g}, about half of its answers on held-out sentences were wrong. It "
+             f"{DOUBT:g}, many of its answers on held-out sentences are wrong. It "
              f"reads: \"{explain(parse(stl))}\". If that is not what you meant, reword the "
              "sentence" + (", or take one of the other readings it weighed:" if others
                            else ".")]
