@@ -21,7 +21,8 @@ from ara.grammars.spot_bridge import equivalent
 SIZES = {"handwritten": (150, 40), "handwritten2": (100, 40), "handwritten3": (60, 15),
          "handwritten4": (150, 60), "handwritten5": (120, 40), "handwritten6": (125, 45),
          "handwritten7": (130, 50), "handwritten8": (135, 55), "handwritten9": (140, 55),
-         "handwritten10": (140, 55), "handwritten11": (150, 60)}
+         "handwritten10": (140, 55), "handwritten11": (150, 60),
+         "handwritten12": (130, 50)}
 #: Each suite's domains: from the fourth on, grounded ones no earlier suite covers.
 FIRST_DOMAINS = {"lifted", "navigation", "manipulation", "warehouse"}
 DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
@@ -35,7 +36,8 @@ DOMAINS = {"handwritten": FIRST_DOMAINS, "handwritten2": FIRST_DOMAINS,
            "handwritten9": {"lifted", "datacenter", "film", "carwash", "zoo", "recycling"},
            "handwritten10": {"lifted", "eldercare", "substation", "themepark", "laundry",
                              "bridge"},
-           "handwritten11": {"lifted", "ski", "museum", "brewery", "pool", "parking"}}
+           "handwritten11": {"lifted", "ski", "museum", "brewery", "pool", "parking"},
+           "handwritten12": {"lifted", "cleanroom", "refinery", "golf", "space", "rescue"}}
 
 
 @pytest.fixture(scope="module", params=sorted(SUITES))
