@@ -18,6 +18,7 @@ app = typer.Typer(
     # Plain help: rich's panels wrap each option's help into a narrow column, several
     # screens for ara translate.
     rich_markup_mode=None,
+    context_settings={"help_option_names": ["-h", "--help"]},
     help="ask-reason-assist: natural language to Signal Temporal Logic with guaranteed "
          "syntax, for multi-robot help requests.",
     no_args_is_help=True,

@@ -20,7 +20,8 @@ EXIT_UNDECIDED = 3
 
 @contextmanager
 def user_errors() -> Iterator[None]:
-    """Print a toolkit error as ``error: ...`` on stderr and exit with code 2 (3 on timeout)."""
+    """Print a toolkit error, or a file that cannot be read or written, as ``error: ...`` on
+    stderr and exit with code 2 (3 on timeout)."""
     try:
         yield
     except TimeoutError as err:
@@ -28,6 +29,10 @@ def user_errors() -> Iterator[None]:
         raise typer.Exit(EXIT_UNDECIDED) from None
     except AraError as err:
         typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+    except OSError as err:  # a path the user gave that cannot be read or written
+        where = f": {err.filename}" if err.filename else ""
+        typer.echo(f"error: {err.strerror or err}{where}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
 
 

@@ -17,16 +17,25 @@ import typer
 
 
 def demo_cmd(
-    n: int = typer.Option(4, "--n", help="How many test pairs to show."),
+    n: int = typer.Option(4, "--n", min=1, max=20, help="How many test pairs to show."),
     seed: int = typer.Option(0, "--seed", help="Which pairs: the sampling seed."),
     model: str = typer.Option("finetuned", "--model",
                               help="Translator model (see ara translate): the shipped fine-tune "
                                    "by default; `default` is the embedded base model."),
-    shots: int = typer.Option(None, "--shots",
+    shots: int = typer.Option(None, "--shots", min=0, max=50,
                               help="Worked examples in the prompt [default: 0 for the "
                                    "fine-tune, which needs none; 5 otherwise]."),
 ) -> None:
     """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
+    from ara.cli_support import user_errors
+    from ara.eval.translate.models import shared_backend
+
+    with user_errors():
+        shared_backend(model)  # a --model that names none is refused before the long part
+        _demo(n, seed, model, shots)
+
+
+def _demo(n: int, seed: int, model: str, shots: int | None) -> None:
     import lark
 
     from ara.data import SPLITS, prepare

@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from ara.cli_support import user_errors
+from ara.errors import ConfigError
 
 coord_app = typer.Typer(help="Multi-robot help requests: Experiment 2, demos, planning.",
                         no_args_is_help=True)
@@ -17,28 +18,37 @@ def _translator(llm: str):
     """None for --llm none; else the eval translator over that model."""
     if llm == "none":
         return None
+    from ara.eval.translate.backends.base import BackendError
     from ara.eval.translate.models import shared_backend
     from ara.eval.translate.translator import Translator
 
-    return Translator(shared_backend(llm))
+    try:
+        return Translator(shared_backend(llm))
+    except BackendError as err:  # its message names --model, this command's option --llm
+        raise BackendError(str(err).replace("--model", "--llm")) from None
 
 
 @coord_app.command("exp2")
 def exp2_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder (resumed if it exists)."),
-    trials: int = typer.Option(100, "--trials", help="Number of trials."),
+    trials: int = typer.Option(100, "--trials", min=1, help="Number of trials."),
     seed: int = typer.Option(3000, "--seed", help="Seed of trial 0; trial i uses seed + i."),
     planner: str = typer.Option("dp", "--planner",
                                 help="dp (exact, fast) or milp (the STL->MILP compiler)."),
     llm: str = typer.Option("none", "--llm",
                             help="none: helpers use the template help spec; else a model "
-                                 "(default, finetuned, FILE.gguf, hf:DIR) that translates "
+                                 "(finetuned, finetuned-paper, default, lora:FILE.gguf, "
+                                 "FILE.gguf, hf:DIR or an http(s):// endpoint) that translates "
                                  "each request (needs --planner milp)."),
     solver: str = typer.Option("highs", "--solver", help="MILP solver: highs or gurobi."),
-    objective: str = typer.Option("paper", "--objective",
-                                  help="Helper objective: paper (D + T_help + T_new) or "
-                                       "authors (T_all + D)."),
-    ils_iterations: int = typer.Option(100, "--ils-iterations", help="Oracle ILS rounds."),
+    objective: str = typer.Option(
+        "paper", "--objective",
+        help="What a helper minimizes: paper (path length + when the requester's wait ends + "
+             "what helping adds to its makespan), authors (the authors' code: its last "
+             "completion time + path length) or makespan."),
+    ils_iterations: int = typer.Option(
+        100, "--ils-iterations", min=0,
+        help="Iterations of the centralized Oracle's iterated local search."),
     instances: str = typer.Option(
         "paper", "--instances",
         help="paper: trials drawn as the authors' code draws them (seeds 3000..3099 give "
@@ -52,7 +62,7 @@ def exp2_cmd(
         "paper", "--wordings",
         help="paper: every trial's request in the paper's words; all: trial i in wording "
              "i mod 11 (the paper's and ten rewordings), to test a translator (--llm)."),
-    processes: int = typer.Option(1, "--processes",
+    processes: int = typer.Option(1, "--processes", min=1,
                                   help="Trials run in parallel (joblib processes)."),
 ) -> None:
     """Reproduce the paper's Experiment 2: trials.csv, summary.json, boxplot.png in OUT."""
@@ -78,12 +88,15 @@ def demo_cmd(
     name: str = typer.Argument(..., help="pallet, kitting or tool."),
     out: Path = typer.Option(Path("runs/demos"), "--out", help="Folder for the PNG and JSON."),
     llm: str = typer.Option("none", "--llm",
-                            help="none: the reference STL; else a model that translates."),
+                            help="none: the reference STL; else a model that translates "
+                                 "(as --llm of ara coord exp2)."),
 ) -> None:
     """Run one of the paper's demonstrations: messages, STL, plan, and a PNG of the paths."""
-    from ara.coordination.demos import run_demo
+    from ara.coordination.demos import DEMOS, run_demo
 
     with user_errors():
+        if name not in DEMOS:  # before a model loads
+            raise ConfigError(f"unknown demo {name!r}: choose one of {', '.join(DEMOS)}")
         run_demo(name, out, _translator(llm), typer.echo)
 
 
@@ -92,9 +105,12 @@ def plan_cmd(
     stl: str = typer.Argument(..., help="A formula over the names given with --at."),
     at: list[str] = typer.Option(..., "--at", help="NAME=ROW,COL for each event, repeatable."),
     start: str = typer.Option("0,0", "--start", help="ROW,COL of the robot."),
-    world_file: Path = typer.Option(None, "--world", help="World file [default: paper 8x8]."),
-    objective: str = typer.Option("makespan", "--objective", help="makespan or authors."),
-    cap: int = typer.Option(None, "--cap", help="Largest makespan allowed."),
+    world_file: Path = typer.Option(
+        None, "--world",
+        help="Grid file: one line a row, '.' free, '#' obstacle [default: the paper's 8x8]."),
+    objective: str = typer.Option("makespan", "--objective",
+                                  help="makespan, paper or authors (as ara coord exp2's)."),
+    cap: int = typer.Option(None, "--cap", min=0, help="Largest makespan allowed."),
     solver: str = typer.Option("highs", "--solver", help="highs or gurobi."),
     as_json: bool = typer.Option(False, "--json", help="One JSON object."),
 ) -> None:

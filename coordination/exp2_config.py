@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ara.coordination.planner_dp import OBJECTIVES
 from ara.coordination.trials import INSTANCES
 from ara.errors import ConfigError
 
@@ -39,6 +40,8 @@ class Exp2Config:
                 "need trials >= 1, robots >= 1, jobs >= 0, cap >= 1 and ils_iterations >= 0; "
                 f"got {self.trials}, {self.robots}, {self.jobs}, {self.cap}, "
                 f"{self.ils_iterations}")
+        if self.objective not in OBJECTIVES:
+            raise ConfigError(f"--objective must be one of {OBJECTIVES}, got {self.objective!r}")
         if self.instances not in INSTANCES:
             raise ConfigError(f"--instances must be one of {INSTANCES}, got {self.instances!r}")
         if self.wordings not in WORDINGS:

@@ -8,22 +8,24 @@ import typer
 
 from ara.cli_support import emit, user_errors
 from ara.data.handwritten import SUITES
-from ara.data.store import SPLITS, load_or_prepare, load_split, prepare, to_hf
+from ara.data.store import SPLITS, load_or_prepare, prepare, to_hf
 
 data_app = typer.Typer(help="Prepare, inspect and export the versioned NL2TL splits.",
                        no_args_is_help=True)
 
-ROOT_OPT = typer.Option(None, "--root", help="Folder of prepared splits [default: data/prepared].")
+ROOT_OPT = typer.Option(None, "--root", file_okay=False,
+                        help="Folder of prepared splits [default: data/prepared].")
 
 
 @data_app.command("prepare")
 def prepare_cmd(
     split: list[str] = typer.Option(
-        list(SPLITS), "--split",
-        help="paper (random 4,500/3,000 rows of navi), disjoint (no lifted formula on both "
-             "sides), timed (NL2TL's own train/dev), compositional (the training mixture "
-             f"and its held-out shapes and phrasings), {', '.join(SUITES)} (the "
-             "hand-written suites, test only). Repeat for several [default: all].",
+        list(SPLITS), "--split", metavar="SPLIT", show_default=False,
+        help="paper (random 4,500/3,000 rows of NL2TL's navigation set), disjoint (no "
+             "lifted formula on both sides), timed (NL2TL's own train/dev), compositional "
+             "(the training mixture and its held-out shapes and phrasings), "
+             f"{', '.join(SUITES)} (the hand-written suites, test only). Repeat for "
+             "several [default: all].",
     ),
     seed: int = typer.Option(0, "--seed", help="Shuffle seed (timed ignores it)."),
     root: Path = ROOT_OPT,
@@ -45,7 +47,9 @@ def prepare_cmd(
 
 @data_app.command("stats")
 def stats_cmd(
-    split: list[str] = typer.Option(list(SPLITS), "--split", help="Splits to describe."),
+    split: list[str] = typer.Option(list(SPLITS), "--split", metavar="SPLIT", show_default=False,
+                                    help="A split to describe; repeat for several "
+                                         "[default: all]."),
     seed: int = typer.Option(0, "--seed", help="Seed the splits were prepared with."),
     root: Path = ROOT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print JSON lines."),
@@ -81,15 +85,18 @@ def _cell(value) -> str:
 
 @data_app.command("export")
 def export_cmd(
-    out: Path = typer.Option(..., "--out", help="Folder to write the Hugging Face dataset to."),
+    out: Path = typer.Option(..., "--out", file_okay=False,
+                             help="Folder to write the Hugging Face dataset to."),
     split: str = typer.Option("paper", "--split", help="Split to export."),
     seed: int = typer.Option(0, "--seed", help="Seed it was prepared with."),
-    form: str = typer.Option(None, "--form", help="lifted or grounded [default: both]."),
+    form: str = typer.Option(None, "--form",
+                             help="lifted (placeholder names prop_1, prop_2, ...) or grounded "
+                                  "(the sentence's own names) [default: both]."),
     root: Path = ROOT_OPT,
 ) -> None:
     """Save a prepared split as a Hugging Face ``datasets`` DatasetDict (save_to_disk)."""
     with user_errors():
-        dataset = to_hf(load_split(split, seed, root), form)
-    dataset.save_to_disk(str(out))
+        dataset = to_hf(load_or_prepare(split, seed, root), form)
+        dataset.save_to_disk(str(out))
     typer.echo(f"wrote {out} ({', '.join(f'{k}: {len(v)}' for k, v in dataset.items())})")
 

@@ -15,14 +15,18 @@ from ara.eval.translate.answering import BUDGET_S
 from ara.eval.translate.confidence import DOUBT
 from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 
-eval_app = typer.Typer(help="The F/P/C ablation of the paper's Experiment 1.",
-                       no_args_is_help=True)
+eval_app = typer.Typer(
+    help="Evaluate translators: one translation with every setting, the paper's ablation of "
+         "few-shot examples (F), the grammar in the prompt (P) and constrained decoding (C) "
+         "judged by Spot, and re-scoring, comparing and judging runs.",
+    no_args_is_help=True)
 
 MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (with "
               "the paper split's), default (without), "
               "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint")
 SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
-               "llama, vllm, sglang, or openai (none: constrained decoding is refused).")
+               "llama, vllm, sglang, or openai (none: constrained decoding is refused, so "
+               "ara translate needs one of the other three).")
 
 
 # The options ``ara translate`` and ``ara translate-file`` share, defined once.
@@ -217,6 +221,8 @@ def translate_file_cmd(
                               budget_s=budget)
         if out.is_dir():
             raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
+        if not out.parent.is_dir():
+            raise ConfigError(f"--out {out}: there is no folder {out.parent}")
         if out.exists() and out.stat().st_size and not resume:
             raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
                               "another --out")
@@ -287,13 +293,13 @@ def ablation_cmd(
         help="How the F variants' worked examples are chosen: random (drawn with --seed, "
              "the same for every test pair of a rerun) or similar (for each test pair, "
              "the pool's pairs most like it; never one with the test's own sentence)."),
-    reruns: int = typer.Option(3, "--reruns", help="Reruns, each with new examples."),
-    limit: int = typer.Option(1000, "--limit", help="Test pairs to sample."),
+    reruns: int = typer.Option(3, "--reruns", min=1, help="Reruns, each with new examples."),
+    limit: int = typer.Option(1000, "--limit", min=1, help="Test pairs to sample."),
     seed: int = typer.Option(0, "--seed", help="Seeds the test sample and the examples."),
     model: str = typer.Option("default", "--model", help=MODEL_HELP),
     mask: str = typer.Option("llguidance", "--mask",
                              help="Constraint engine: llguidance (fast) or llama (built-in)."),
-    spot_timeout: float = typer.Option(10.0, "--spot-timeout",
+    spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
                                        help="Seconds per Spot check before 'undecided'."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
@@ -327,7 +333,7 @@ def ablation_cmd(
             data=None if data is None else str(data),
             examples=None if examples is None else str(examples),
             variants=split_list(variants),
-            shots=tuple(int(k) for k in split_list(shots)), reruns=reruns, limit=limit,
+            shots=_counts(shots, "--shots"), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout,
             repair=RepairConfig(repair, repair_by, doubt), examples_by=examples_by,
         )
@@ -401,11 +407,22 @@ def verdict_cmd(
     emit(result, as_json, verdict_markdown)
 
 
+def _counts(text: str, option: str) -> tuple[int, ...]:
+    """``"0,5"`` -> ``(0, 5)``, or a ConfigError naming the option."""
+    try:
+        return tuple(int(k) for k in split_list(text))
+    except ValueError:
+        raise ConfigError(f"{option} takes comma-separated whole numbers, e.g. 0,5; "
+                          f"got {text!r}") from None
+
+
 @eval_app.command("ceiling")
 def ceiling_cmd(
-    split: str = typer.Option("paper", "--split", help="paper, disjoint or timed."),
+    split: str = typer.Option("paper", "--split",
+                              help="paper, disjoint, timed, compositional or a hand-written "
+                                   "suite (handwritten, handwritten2, ...)."),
     form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
-    limit: int = typer.Option(0, "--limit",
+    limit: int = typer.Option(0, "--limit", min=0,
                               help="Measure the sample an ablation with this --limit and "
                                    "--seed scores (0: the whole test side)."),
     seed: int = typer.Option(0, "--seed", help="Seed of that sample."),
@@ -413,11 +430,11 @@ def ceiling_cmd(
 ) -> None:
     """The accuracy the data set's own labels allow: where one sentence carries
     non-equivalent formulas, no translator can match them all."""
-    from ara.data import load_split
+    from ara.data import load_or_prepare
     from ara.eval.ceiling import split_ceiling
 
     with user_errors():
-        result = split_ceiling(load_split(split), form, limit, seed).to_dict()
+        result = split_ceiling(load_or_prepare(split), form, limit, seed).to_dict()
     result.update(split=split, form=form, limit=limit or None, seed=seed)
 
     def text(d: dict) -> str:

@@ -145,13 +145,14 @@ class AblationConfig:
             # NL2TL's timed formulas carry intervals: a grammar without them could not
             # express a single reference.
             object.__setattr__(self, "translator", replace(self.translator, intervals=True))
-        if (not self.variants or any(not 0 <= k <= MAX_SHOTS for k in self.shots)
-                or self.reruns < 1 or self.limit < 1):
-            raise ConfigError(
-                f"need at least one variant, shots from 0 to {MAX_SHOTS}, reruns >= 1 and "
-                f"limit >= 1; got variants={self.variants}, shots={self.shots}, "
-                f"reruns={self.reruns}, limit={self.limit}"
-            )
+        if not self.variants:
+            raise ConfigError("variants: name at least one, e.g. C or none,C,F+C")
+        if not self.shots or any(not 0 <= k <= MAX_SHOTS for k in self.shots):
+            raise ConfigError(f"shots: counts from 0 to {MAX_SHOTS}, got {self.shots}")
+        if self.reruns < 1:
+            raise ConfigError(f"reruns: at least 1, got {self.reruns}")
+        if self.limit < 1:
+            raise ConfigError(f"limit: at least 1 test pair, got {self.limit}")
         if self.repair.samples is None:  # an ablation states its repair: none by default
             raise ConfigError("repair.samples: name the answers to draw, 0 to 32 (0: off)")
         if self.examples_by not in EXAMPLES_BY:

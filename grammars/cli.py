@@ -7,28 +7,42 @@ from enum import Enum
 import typer
 
 from ara.cli_support import emit, split_list, user_errors
+from ara.errors import ConfigError
 from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
 from ara.grammars.stl_grammar import build_grammar
 from ara.grammars.syntax import Syntax
 
+SYNTAX_HELP = (
+    "Syntax: propositions [A-Za-z_][A-Za-z0-9_]*, true, false; ! (not), & (and), | (or), "
+    "-> (implies), <-> (iff); F (eventually), G (always), X (next), a U b (until); time "
+    "windows in steps: F[2,5](a), G[0,30](!b), a U[0,4] b, F[3,inf](a). Loosest first: "
+    "<->, ->, |, &, U, then the prefix operators. In full: docs/language.md."
+)
+
 stl_app = typer.Typer(
-    help="Parse, print and compare STL formulas (see the README for the syntax).",
+    help="Parse, print and compare STL formulas. " + SYNTAX_HELP,
     no_args_is_help=True,
 )
 
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object instead of text.")
 TIMEOUT_OPT = typer.Option(
-    60.0, "--timeout", help="Seconds Spot may take; past it, exit 3 (undecided)."
+    60.0, "--timeout", min=0.1,
+    help="Seconds Spot may take; past it, exit 3 (undecided). Wide windows nested under G "
+         "take longest."
 )
 
 
 @stl_app.command("parse")
 def parse_cmd(
-    formula: str = typer.Argument(..., help="A formula, e.g. 'F(a) & G[0,30](!b)'."),
+    formula: str = typer.Argument(..., metavar="FORMULA",
+                                  help="A formula, e.g. 'F(a) & G[0,30](!b)'."),
     as_json: bool = JSON_OPT,
 ) -> None:
-    """Print FORMULA in canonical form; exit 2 naming the position if it is invalid."""
+    """Print FORMULA in canonical form; exit 2 naming the position if it is invalid.
+
+    Syntax: propositions [A-Za-z_][A-Za-z0-9_]*, true, false; ! & | -> <->; F G X U, with
+    time windows in steps: F[2,5](a), G[0,30](!b), a U[0,4] b (docs/language.md)."""
     with user_errors():
         tree = parse(formula)
     emit({"stl": to_text(tree), "valid": True}, as_json, lambda v: v["stl"])
@@ -36,7 +50,8 @@ def parse_cmd(
 
 @stl_app.command("explain")
 def explain_cmd(
-    formula: str = typer.Argument(..., help="A formula, e.g. 'G(door_open -> F[0,5](close))'."),
+    formula: str = typer.Argument(..., metavar="FORMULA",
+                                  help="A formula, e.g. 'G(door_open -> F[0,5](close))'."),
     as_json: bool = JSON_OPT,
 ) -> None:
     """Read FORMULA back in plain English, deterministically (same realizer as the data)."""
@@ -49,8 +64,8 @@ def explain_cmd(
 
 @stl_app.command("equiv")
 def equiv_cmd(
-    a: str = typer.Argument(..., help="First formula."),
-    b: str = typer.Argument(..., help="Second formula."),
+    a: str = typer.Argument(..., metavar="A", help="First formula."),
+    b: str = typer.Argument(..., metavar="B", help="Second formula."),
     as_json: bool = JSON_OPT,
     timeout: float = TIMEOUT_OPT,
 ) -> None:
@@ -63,8 +78,8 @@ def equiv_cmd(
 
 @stl_app.command("implies")
 def implies_cmd(
-    a: str = typer.Argument(..., help="Premise."),
-    b: str = typer.Argument(..., help="Conclusion."),
+    a: str = typer.Argument(..., metavar="A", help="Premise."),
+    b: str = typer.Argument(..., metavar="B", help="Conclusion."),
     as_json: bool = JSON_OPT,
     timeout: float = TIMEOUT_OPT,
 ) -> None:
@@ -93,24 +108,29 @@ def grammar_cmd(
     intervals: bool = typer.Option(
         False, "--intervals", help="Allow F[lo,hi], G[lo,hi], U[lo,hi]."
     ),
-    max_bound: int = typer.Option(1000, "--max-bound", help="Largest time bound in an interval."),
-    allow_inf: bool = typer.Option(False, "--allow-inf", help="Allow [lo,inf] intervals."),
+    max_bound: int = typer.Option(1000, "--max-bound", min=0,
+                                  help="Largest time bound in an interval (with --intervals)."),
+    allow_inf: bool = typer.Option(False, "--allow-inf",
+                                   help="Allow [lo,inf] intervals (with --intervals)."),
     allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),
     relaxed: bool = typer.Option(
         False, "--relaxed",
         help="Paper-style layout: precedence, optional parentheses and spaces, ! or ~.",
     ),
     max_depth: int = typer.Option(
-        None, "--max-depth", help="Canonical layout: bound the nesting depth (finite language)."
+        None, "--max-depth", min=1,
+        help="Canonical layout: bound the nesting depth (finite language)."
     ),
     max_args: int = typer.Option(
-        None, "--max-args", help="Canonical layout: bound the arguments of one & or |."
+        None, "--max-args", min=2, help="Canonical layout: bound the arguments of one & or |."
     ),
     fmt: GrammarFormat = typer.Option(GrammarFormat.gbnf, "--format", help="Output format."),
 ) -> None:
     """Print the grammar of STL over the given propositions (GBNF for llama.cpp, Lark for
     outlines/llguidance). The parser accepts exactly the strings this grammar admits."""
     with user_errors():
+        if not intervals and (allow_inf or max_bound != 1000):
+            raise ConfigError("--max-bound and --allow-inf shape intervals: add --intervals")
         syntax = Syntax(aps=split_list(aps), intervals=intervals, max_bound=max_bound,
                         allow_inf=allow_inf, allow_next=allow_next, relaxed=relaxed,
                         max_depth=max_depth, max_args=max_args)

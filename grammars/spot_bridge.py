@@ -129,8 +129,8 @@ def _check_bounds(*formulas: Formula) -> None:
             raise BoundTooLargeError(
                 f"time bound {bound} in {to_text(f)!r} exceeds SPOT_MAX_BOUND={SPOT_MAX_BOUND}: "
                 "Spot unrolls bounds into nested X and the check would not finish in "
-                "reasonable time; rescale the time unit or raise "
-                "ara.grammars.spot_bridge.SPOT_MAX_BOUND at your own cost"
+                "reasonable time; rescale the time unit (from Python, "
+                "ara.grammars.spot_bridge.SPOT_MAX_BOUND may be raised at your own cost)"
             )
 
 
@@ -241,8 +241,9 @@ class _Worker:
                 self.proc.join()
                 _Worker._instance = None
                 raise SpotTimeoutError(
-                    f"Spot did not decide {op}({a}, {b}) within {timeout_s:g} s; the check "
-                    "is exponential in the width of windows nested under G"
+                    f"Spot did not decide {op} within {timeout_s:g} s (give it longer: "
+                    "--timeout, --spot-timeout); the check is exponential in the width of "
+                    "windows nested under G"
                 )
             self.cache[key] = self.conn.recv()
         return self.cache[key]

@@ -135,6 +135,61 @@ def test_every_command_explains_itself(command):
     assert result.exit_code == 0 and "Usage" in result.output and len(result.output) > 200
 
 
+def test_short_help_works_too():
+    assert ara("-h").returncode == 0 and "Usage" in ara("stl", "parse", "-h").stdout
+
+
+def test_stl_help_gives_the_syntax():
+    help_text = runner.invoke(app, ["stl", "--help"], terminal_width=100).output
+    assert "F[2,5](a)" in help_text and "U[0,4]" in help_text
+
+
+@pytest.mark.parametrize(
+    ("args", "says"),
+    [(["grammar", "--aps", "a", "--allow-inf"], "add --intervals"),
+     (["grammar", "--aps", "a", "--max-bound", "5"], "add --intervals"),
+     (["stl", "equiv", "F(a)", "F(b)", "--timeout", "0"], "--timeout"),
+     (["eval", "ablation", "--out", "unused", "--shots", "abc"],
+      "--shots takes comma-separated whole numbers"),
+     (["eval", "ablation", "--out", "unused", "--reruns", "0"], "--reruns"),
+     (["coord", "exp2", "--out", "unused", "--processes", "0"], "--processes"),
+     (["coord", "exp2", "--out", "unused", "--objective", "fastest"], "--objective"),
+     (["coord", "demo", "dance", "--llm", "not-a-model"], "unknown demo 'dance'"),
+     (["demo", "--n", "0"], "--n"),
+     (["translate", "go to the kitchen", "--aps", "Bad-Name", "--model", "not-a-model"],
+      "'Bad-Name' is not a valid name"),
+     (["translate", "go to the kitchen", "--aps", ",", "--model", "not-a-model"],
+      "name at least one in --aps")],
+)
+def test_bad_input_is_one_line_of_error_and_exit_2_before_any_model_loads(args, says, tmp_path):
+    """Each of these is refused in the arguments, so the model named (none) never loads,
+    and nothing is written: --out names a folder that is never made."""
+    out = ara(*[str(tmp_path / a) if a == "unused" else a for a in args])
+    assert out.returncode == 2 and says in out.stderr + out.stdout, out.stderr
+    assert "Traceback" not in out.stderr and not (tmp_path / "unused").exists()
+
+
+def test_a_config_that_is_not_a_yaml_mapping_is_named(tmp_path):
+    broken, listed = tmp_path / "broken.yaml", tmp_path / "listed.yaml"
+    broken.write_text("lora: {r: 16\n")
+    listed.write_text("- r: 16\n")
+    for status in ([], ["--status"]):
+        out = ara("train", "--config", str(broken), *status)
+        assert out.returncode == 2 and "is not valid YAML" in out.stderr
+        out = ara("train", "--config", str(listed), *status)
+        assert out.returncode == 2 and "must be a YAML mapping" in out.stderr
+
+
+def test_a_path_that_cannot_be_written_is_an_error_not_a_traceback(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    out = ara("translate-file", "docs/examples/requests.jsonl", "--out",
+              str(tmp_path / "missing" / "answers.jsonl"), "--model", "not-a-model")
+    assert out.returncode == 2 and "there is no folder" in out.stderr
+    out = ara("data", "export", "--split", "handwritten3", "--out", str(blocker / "x"))
+    assert out.returncode == 2 and out.stderr.startswith("error: ") and "file" in out.stderr
+
+
 def test_translate_help_fits_one_screen_and_leaves_the_experiments_knobs_to_eval():
     help_text = runner.invoke(app, ["translate", "--help"], terminal_width=80).output
     assert len(help_text.splitlines()) <= 60 and "ara eval translate" in help_text

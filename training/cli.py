@@ -35,7 +35,7 @@ def train_cmd(
                                 help="A run config, or a staged recipe (a config with "
                                      "`stages:`), e.g. training/configs/gemma3_270m_nl2tl.yaml."),
     max_steps: int = typer.Option(
-        None, "--max-steps",
+        None, "--max-steps", min=1,
         help="Stop after N optimizer steps (in a recipe: each training stage at most N, a "
              "smoke run whose stages a run without the flag trains again)."),
     resume: bool = typer.Option(
@@ -91,15 +91,12 @@ def train_cmd(
 
 
 def _print_status(config: Path, max_steps: int | None, as_json: bool) -> None:
-    import yaml
-
     from ara.cli_support import emit
+    from ara.training.config import read_config
     from ara.training.stage_runner import recipe_status
     from ara.training.stages import StagedRecipe, is_staged
 
-    if not config.is_file():
-        raise ConfigError(f"config file not found: {config}")
-    data = yaml.safe_load(config.read_text()) or {}
+    data = read_config(config)
     if not is_staged(data):
         raise ConfigError(f"{config} is a single run, not a staged recipe: its progress is "
                           "in OUT/train_log.jsonl (a line a step) and OUT/checkpoints/")

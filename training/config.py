@@ -17,6 +17,23 @@ from ara.errors import ConfigError, refuse_unknown_keys
 from ara.eval.translate.models import SHIPPED
 
 
+def read_config(path: str | Path) -> dict:
+    """A config file's settings: a YAML mapping, or a ConfigError that says what is wrong."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"config file not found: {path}")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise ConfigError(f"{path} is not valid YAML: {err}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path} must be a YAML mapping of settings (key: value), "
+                          f"not a {type(data).__name__}")
+    return data
+
+
 def _build(cls, data: dict | None, where: str):
     data = data or {}
     if not isinstance(data, dict):
@@ -224,10 +241,7 @@ class TrainConfig:
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> TrainConfig:
-        path = Path(path)
-        if not path.is_file():
-            raise ConfigError(f"config file not found: {path}")
-        return cls.from_dict(yaml.safe_load(path.read_text()) or {})
+        return cls.from_dict(read_config(path))
 
     def to_dict(self) -> dict:
         data = asdict(self)

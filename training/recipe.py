@@ -20,13 +20,12 @@ import warnings
 from pathlib import Path
 
 import torch
-import yaml
 from tqdm import tqdm
 
 from ara import __version__
 from ara.errors import ConfigError
 from ara.provenance import write_atomic
-from ara.training.config import TrainConfig
+from ara.training.config import TrainConfig, read_config
 from ara.training.dataset import (
     answer_loss_sum,
     batch_shots,
@@ -394,10 +393,7 @@ def main(config_path: str, max_steps: int | None = None, resume: bool = False) -
     from ara.training.stage_runner import run_recipe
     from ara.training.stages import StagedRecipe, is_staged
 
-    path = Path(config_path)
-    if not path.is_file():
-        raise ConfigError(f"config file not found: {path}")
-    data = yaml.safe_load(path.read_text()) or {}
+    data = read_config(config_path)
     if is_staged(data):
         # A recipe resumes by itself: each rerun goes on where the last one stopped.
         return run_recipe(StagedRecipe.from_dict(data), max_steps)

@@ -71,9 +71,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
         return LlamaCppBackend(model, n_ctx=n_ctx, mask=mask)
     raise BackendError(
         f"--model {model!r} names no model: use default, finetuned, finetuned-paper, "
-        "lora:ADAPTER.gguf, a path "
-        "ending in .gguf, "
-        "hf:FOLDER_OR_ID, or an http(s):// endpoint"
+        "lora:ADAPTER.gguf, a path ending in .gguf, hf:FOLDER, or an http(s):// endpoint"
     )
 
 

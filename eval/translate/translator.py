@@ -138,12 +138,17 @@ def check_request(nl: str, aps: Sequence[str], config: TranslatorConfig) -> None
     """Refuse a request a user most likely got wrong, saying what to change.
 
     Raises:
-        RequestError: If ``nl`` is blank, a proposition is never mentioned, or a
-            number in ``nl`` is above the grammar's largest bound.
+        RequestError: If ``nl`` is blank, no proposition is given, one is never
+            mentioned, or a number in ``nl`` is above the grammar's largest bound.
+        ConfigError: If a proposition is not a valid name.
     """
     if not nl.strip():
         raise RequestError("the instruction is empty: pass the sentence to translate, e.g. "
                            "'always avoid the door'")
+    if not aps:
+        raise RequestError("no propositions: name at least one in --aps, comma-separated "
+                           "(e.g. go_to_kitchen,door_open)")
+    Syntax(aps=tuple(aps))  # a bad name is refused here, before any model loads
     request = Request.of(nl, aps)
     unmentioned = request.unmentioned
     if unmentioned:

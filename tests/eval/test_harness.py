@@ -98,7 +98,7 @@ def test_zero_shots_runs_f_zero_shot_and_too_many_is_refused(paper_split):
     jobs = list(plan(config, paper_split))
     assert {(j.variant.name, j.shots) for j in jobs} == {("F+C", 0), ("F+C", 2), ("C", 0)}
     assert all(j.examples == () for j in jobs if j.shots == 0)
-    with pytest.raises(ConfigError, match="shots from 0 to 50"):
+    with pytest.raises(ConfigError, match="shots: counts from 0 to 50"):
         AblationConfig(shots=(99999,))
 
 

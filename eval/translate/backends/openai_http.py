@@ -117,9 +117,10 @@ class OpenAIBackend:
         where = GRAMMAR_FIELDS[self.server]
         if where is None:
             raise BackendError(
-                "this endpoint was named as plain OpenAI, which takes no grammar: name the "
-                "server that runs it (--server llama|vllm|sglang) for constrained variants "
-                "(C), or run them with a local model (default, a .gguf path or hf:...)")
+                "this server is named as plain OpenAI (--server openai, the default), which "
+                "cannot decode under a grammar: name the server that runs it with --server "
+                "llama, vllm or sglang, or use a local model (finetuned, a .gguf path or "
+                "hf:FOLDER)")
         gbnf = grammar.grammar.to_gbnf()
         if "." in where:
             outer, inner = where.split(".")
