@@ -103,7 +103,8 @@ def demo_cmd(
 @coord_app.command("plan")
 def plan_cmd(
     stl: str = typer.Argument(..., help="A formula over the names given with --at."),
-    at: list[str] = typer.Option(..., "--at", help="NAME=ROW,COL for each event, repeatable."),
+    at: list[str] = typer.Option(..., "--at", metavar="NAME=ROW,COL",
+                                 help="Where each event is, repeated for each."),
     start: str = typer.Option("0,0", "--start", help="ROW,COL of the robot."),
     world_file: Path = typer.Option(
         None, "--world",

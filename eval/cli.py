@@ -72,7 +72,8 @@ BUDGET = typer.Option(
 AS_JSON = typer.Option(False, "--json", help="Print one JSON object.")
 APS = typer.Option(..., "--aps", help="Comma-separated propositions, each named in the "
                    "sentence (go_to_kitchen: 'go to the kitchen').")
-NL = typer.Argument(..., help="The instruction, e.g. 'always avoid the door'.")
+NL = typer.Argument(..., metavar="INSTRUCTION",
+                    help="The instruction, e.g. 'always avoid the door'.")
 
 
 def translate_cmd(

@@ -123,10 +123,10 @@ def _status_table(status: dict) -> str:
 
 
 def soup_cmd(
-    runs: list[Path] = typer.Option(..., "--run",
+    runs: list[Path] = typer.Option(..., "--run", metavar="RUN_DIR",
                                     help="A finished `ara train` run folder (twice or more)."),
     weights: list[float] = typer.Option(
-        None, "--weight", help="One weight per --run, in order (default: all equal)."),
+        None, "--weight", metavar="W", help="One weight per --run, in order (default: all equal)."),
     out: Path = typer.Option(..., "--out", help="The soup's run folder (adapter/, run.json)."),
     rank: int = typer.Option(
         None, "--rank", min=1,
