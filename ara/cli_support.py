@@ -30,9 +30,12 @@ def user_errors() -> Iterator[None]:
     except AraError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
-    except OSError as err:  # a path the user gave that cannot be read or written
-        where = f": {err.filename}" if err.filename else ""
-        typer.echo(f"error: {err.strerror or err}{where}", err=True)
+    except OSError as err:
+        if not err.filename:  # not a path: a failure of the machine, with its traceback
+            raise
+        # A path that cannot be read or written: most often one the user gave.
+        where = err.filename + (f" -> {err.filename2}" if err.filename2 else "")
+        typer.echo(f"error: {err.strerror or err}: {where}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
 
 

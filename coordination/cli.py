@@ -25,7 +25,8 @@ def _translator(llm: str):
     try:
         return Translator(shared_backend(llm))
     except BackendError as err:  # its message names --model, this command's option --llm
-        raise BackendError(str(err).replace("--model", "--llm")) from None
+        raise BackendError(str(err).replace("--model", "--llm").replace(
+            "names no model: use", "names no model: use none,")) from err
 
 
 @coord_app.command("exp2")
@@ -85,7 +86,7 @@ def exp2_cmd(
 
 @coord_app.command("demo")
 def demo_cmd(
-    name: str = typer.Argument(..., help="pallet, kitting or tool."),
+    name: str = typer.Argument(..., metavar="NAME", help="pallet, kitting or tool."),
     out: Path = typer.Option(Path("runs/demos"), "--out", help="Folder for the PNG and JSON."),
     llm: str = typer.Option("none", "--llm",
                             help="none: the reference STL; else a model that translates "
@@ -102,10 +103,12 @@ def demo_cmd(
 
 @coord_app.command("plan")
 def plan_cmd(
-    stl: str = typer.Argument(..., help="A formula over the names given with --at."),
+    stl: str = typer.Argument(..., metavar="FORMULA",
+                              help="A formula over the names given with --at."),
     at: list[str] = typer.Option(..., "--at", metavar="NAME=ROW,COL",
                                  help="Where each event is, repeated for each."),
-    start: str = typer.Option("0,0", "--start", help="ROW,COL of the robot."),
+    start: str = typer.Option("0,0", "--start", metavar="ROW,COL",
+                              help="Where the robot starts."),
     world_file: Path = typer.Option(
         None, "--world",
         help="Grid file: one line a row, '.' free, '#' obstacle [default: the paper's 8x8]."),

@@ -108,8 +108,9 @@ def grammar_cmd(
     intervals: bool = typer.Option(
         False, "--intervals", help="Allow F[lo,hi], G[lo,hi], U[lo,hi]."
     ),
-    max_bound: int = typer.Option(1000, "--max-bound", min=0,
-                                  help="Largest time bound in an interval (with --intervals)."),
+    max_bound: int = typer.Option(None, "--max-bound", min=0, show_default=False,
+                                  help="Largest time bound in an interval (with --intervals) "
+                                       "[default: 1000, what Spot can check]."),
     allow_inf: bool = typer.Option(False, "--allow-inf",
                                    help="Allow [lo,inf] intervals (with --intervals)."),
     allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),
@@ -129,9 +130,10 @@ def grammar_cmd(
     """Print the grammar of STL over the given propositions (GBNF for llama.cpp, Lark for
     outlines/llguidance). The parser accepts exactly the strings this grammar admits."""
     with user_errors():
-        if not intervals and (allow_inf or max_bound != 1000):
+        if not intervals and (allow_inf or max_bound is not None):
             raise ConfigError("--max-bound and --allow-inf shape intervals: add --intervals")
-        syntax = Syntax(aps=split_list(aps), intervals=intervals, max_bound=max_bound,
+        bound = {} if max_bound is None else {"max_bound": max_bound}
+        syntax = Syntax(aps=split_list(aps), intervals=intervals, **bound,
                         allow_inf=allow_inf, allow_next=allow_next, relaxed=relaxed,
                         max_depth=max_depth, max_args=max_args)
         built = build_grammar(syntax)

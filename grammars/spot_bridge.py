@@ -122,6 +122,11 @@ def _until_text(lhs: Formula, rhs: Formula, interval: Interval | None) -> str:
     return "(" + " & ".join(parts) + ")"
 
 
+def _short(text: str, most: int = 60) -> str:
+    """Spot's unrolled windows run to pages: enough of one to recognize it."""
+    return text if len(text) <= most else text[:most - 3] + "..."
+
+
 def _check_bounds(*formulas: Formula) -> None:
     for f in formulas:
         bound = max_bound(f)
@@ -241,9 +246,9 @@ class _Worker:
                 self.proc.join()
                 _Worker._instance = None
                 raise SpotTimeoutError(
-                    f"Spot did not decide {op} within {timeout_s:g} s (give it longer: "
-                    "--timeout, --spot-timeout); the check is exponential in the width of "
-                    "windows nested under G"
+                    f"Spot did not decide {op}({_short(a)}, {_short(b)}) within "
+                    f"{timeout_s:g} s; the check is exponential in the width of windows "
+                    "nested under G (give it longer: timeout_s, or --timeout, --spot-timeout)"
                 )
             self.cache[key] = self.conn.recv()
         return self.cache[key]

@@ -2,7 +2,7 @@
 
     .venv/bin/python scripts/ship_adapter.py runs/recipe/gemma3-270m-nl2tl/export
     .venv/bin/python scripts/ship_adapter.py runs/train/gemma3-270m-lora \\
-        --name gemma3-270m-nl2tl-paper-lora.gguf --split paper
+        --name gemma3-270m-nl2tl-paper-lora.gguf --split paper --despite "judged by Table I"
 
 EXPORT is the recipe's export stage, or a run folder that `ara export --lora-gguf` wrote
 into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT into

@@ -155,7 +155,7 @@ def test_stl_help_gives_the_syntax():
      (["coord", "exp2", "--out", "unused", "--processes", "0"], "--processes"),
      (["coord", "exp2", "--out", "unused", "--objective", "fastest"], "--objective"),
      (["coord", "demo", "dance", "--llm", "not-a-model"], "unknown demo 'dance'"),
-     (["demo", "--n", "0"], "--n"),
+     (["demo", "--n", "0", "--model", "not-a-model"], "--n"),
      (["translate", "go to the kitchen", "--aps", "Bad-Name", "--model", "not-a-model"],
       "'Bad-Name' is not a valid name"),
      (["translate", "go to the kitchen", "--aps", ",", "--model", "not-a-model"],
@@ -181,13 +181,16 @@ def test_a_config_that_is_not_a_yaml_mapping_is_named(tmp_path):
 
 
 def test_a_path_that_cannot_be_written_is_an_error_not_a_traceback(tmp_path):
-    blocker = tmp_path / "file"
-    blocker.write_text("")
-    out = ara("translate-file", "docs/examples/requests.jsonl", "--out",
+    requests = Path(__file__).resolve().parents[1] / "docs" / "examples" / "requests.jsonl"
+    out = ara("translate-file", str(requests), "--out",
               str(tmp_path / "missing" / "answers.jsonl"), "--model", "not-a-model")
     assert out.returncode == 2 and "there is no folder" in out.stderr
-    out = ara("data", "export", "--split", "handwritten3", "--out", str(blocker / "x"))
-    assert out.returncode == 2 and out.stderr.startswith("error: ") and "file" in out.stderr
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    out = ara("data", "export", "--split", "handwritten3", "--root", str(tmp_path / "splits"),
+              "--out", str(blocker / "dataset"))
+    assert out.returncode == 2 and out.stderr.startswith("error: ")
+    assert str(blocker / "dataset") in out.stderr and "Traceback" not in out.stderr
 
 
 def test_translate_help_fits_one_screen_and_leaves_the_experiments_knobs_to_eval():
