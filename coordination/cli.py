@@ -4,11 +4,25 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Literal
 
 import typer
 
 from ara.cli_support import user_errors
+from ara.coordination.exp2_config import WAITS, WORDINGS
+from ara.coordination.milp import SOLVERS
+from ara.coordination.planner_dp import OBJECTIVES
+from ara.coordination.protocol import PLANNERS
+from ara.coordination.trials import INSTANCES
 from ara.errors import ConfigError
+
+# Options with a fixed set of values: the help lists them, and typer refuses others.
+Planner = Literal[PLANNERS]
+Solver = Literal[tuple(SOLVERS)]
+Objective = Literal[OBJECTIVES]
+Instances = Literal[INSTANCES]
+Wait = Literal[WAITS]
+Wordings = Literal[WORDINGS]
 
 coord_app = typer.Typer(help="Multi-robot help requests: Experiment 2, demos, planning.",
                         no_args_is_help=True)
@@ -34,15 +48,16 @@ def exp2_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder (resumed if it exists)."),
     trials: int = typer.Option(100, "--trials", min=1, help="Number of trials."),
     seed: int = typer.Option(3000, "--seed", help="Seed of trial 0; trial i uses seed + i."),
-    planner: str = typer.Option("dp", "--planner",
+    planner: Planner = typer.Option("dp", "--planner",
                                 help="dp (exact, fast) or milp (the STL->MILP compiler)."),
     llm: str = typer.Option("none", "--llm",
                             help="none: helpers use the template help spec; else a model "
                                  "(finetuned, finetuned-paper, default, lora:FILE.gguf, "
                                  "FILE.gguf, hf:DIR or an http(s):// endpoint) that translates "
                                  "each request (needs --planner milp)."),
-    solver: str = typer.Option("highs", "--solver", help="MILP solver: highs or gurobi."),
-    objective: str = typer.Option(
+    solver: Solver = typer.Option("highs", "--solver",
+                               help="MILP solver: highs or gurobi."),
+    objective: Objective = typer.Option(
         "paper", "--objective",
         help="What a helper minimizes: paper (path length + when the requester's wait ends + "
              "what helping adds to its makespan), authors (the authors' code: its last "
@@ -50,16 +65,16 @@ def exp2_cmd(
     ils_iterations: int = typer.Option(
         100, "--ils-iterations", min=0,
         help="Iterations of the centralized Oracle's iterated local search."),
-    instances: str = typer.Option(
+    instances: Instances = typer.Option(
         "paper", "--instances",
         help="paper: trials drawn as the authors' code draws them (seeds 3000..3099 give "
              "the paper's instances); uniform: this project's earlier generator."),
-    wait: str = typer.Option(
+    wait: Wait = typer.Option(
         "arrival", "--wait",
         help="When the requester's wait ends: arrival (the helper reaches the site, the "
              "paper's count) or drop (the pallet is put down, one step later). "
              "summary.json holds both."),
-    wordings: str = typer.Option(
+    wordings: Wordings = typer.Option(
         "paper", "--wordings",
         help="paper: every trial's request in the paper's words; all: trial i in wording "
              "i mod 11 (the paper's and ten rewordings), to test a translator (--llm)."),
@@ -112,10 +127,11 @@ def plan_cmd(
     world_file: Path = typer.Option(
         None, "--world",
         help="Grid file: one line a row, '.' free, '#' obstacle [default: the paper's 8x8]."),
-    objective: str = typer.Option("makespan", "--objective",
+    objective: Objective = typer.Option("makespan", "--objective",
                                   help="makespan, paper or authors (as ara coord exp2's)."),
     cap: int = typer.Option(None, "--cap", min=0, help="Largest makespan allowed."),
-    solver: str = typer.Option("highs", "--solver", help="highs or gurobi."),
+    solver: Solver = typer.Option("highs", "--solver",
+                               help="highs or gurobi."),
     as_json: bool = typer.Option(False, "--json", help="One JSON object."),
 ) -> None:
     """Plan a robot's path for an STL spec with the event MILP (no plan: exit 1)."""

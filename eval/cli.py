@@ -5,15 +5,25 @@ from __future__ import annotations
 import json
 import signal
 from pathlib import Path
+from typing import Literal
 
 import typer
 
 from ara.cli_support import emit, split_list, user_errors
 from ara.data.handwritten import SUITES
+from ara.data.store import FORMS
 from ara.errors import ConfigError
 from ara.eval.translate.answering import BUDGET_S
+from ara.eval.translate.backends.openai_http import GRAMMAR_FIELDS
 from ara.eval.translate.confidence import DOUBT
 from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
+from ara.eval.translate.similar import EXAMPLES_BY as EXAMPLES_BY_VALUES
+
+# Options with a fixed set of values: the help lists them, and typer refuses others.
+ExamplesBy = Literal[EXAMPLES_BY_VALUES]
+RepairBy = Literal[REPAIR_BY]
+Server = Literal[tuple(GRAMMAR_FIELDS)]
+Form = Literal[FORMS]
 
 eval_app = typer.Typer(
     help="Evaluate translators: one translation with every setting, the paper's ablation of "
@@ -56,7 +66,8 @@ ANY_BOUND = typer.Option(
 TEMPERATURE = typer.Option(0.7, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
                              f"{DEFAULT_REPAIR} (0 where answers are voted); 0: off.")
-REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])
+REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by",
+                                help=REPAIR_HELP["by"])
 DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
@@ -81,7 +92,7 @@ def translate_cmd(
     aps: str = APS,
     model: str = MODEL,
     shots: int | None = SHOTS,
-    examples_by: str = EXAMPLES_BY,
+    examples_by: ExamplesBy = EXAMPLES_BY,
     examples: Path | None = EXAMPLES,
     seed: int = SEED,
     intervals: bool = INTERVALS,
@@ -90,7 +101,7 @@ def translate_cmd(
     repair: int | None = REPAIR_OPTION,
     alternatives: int = ALTERNATIVES,
     budget: float = BUDGET,
-    server: str = SERVER,
+    server: Server = SERVER,
     as_json: bool = AS_JSON,
 ) -> None:
     """Translate one instruction into STL over the given propositions.
@@ -113,7 +124,7 @@ def eval_translate_cmd(
     grammar_in_prompt: bool = typer.Option(False, "--grammar-in-prompt",
                                            help="Show the grammar in the prompt."),
     shots: int | None = SHOTS,
-    examples_by: str = EXAMPLES_BY,
+    examples_by: ExamplesBy = EXAMPLES_BY,
     examples: Path | None = EXAMPLES,
     seed: int = SEED,
     intervals: bool = INTERVALS,
@@ -125,11 +136,11 @@ def eval_translate_cmd(
              "grouped by Spot equivalence; the largest group wins. 1: greedy."),
     temperature: float = TEMPERATURE,
     repair: int | None = REPAIR_OPTION,
-    repair_by: str = REPAIR_BY_OPTION,
+    repair_by: RepairBy = REPAIR_BY_OPTION,
     doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,
     budget: float = BUDGET,
-    server: str = SERVER,
+    server: Server = SERVER,
     as_json: bool = AS_JSON,
 ) -> None:
     """`ara translate` with every knob of the experiments: self-consistency votes,
@@ -171,7 +182,7 @@ def translate_file_cmd(
                                      "OUT with .settings.json for its suffix)."),
     model: str = MODEL,
     shots: int | None = SHOTS,
-    examples_by: str = EXAMPLES_BY,
+    examples_by: ExamplesBy = EXAMPLES_BY,
     examples: Path | None = EXAMPLES,
     seed: int = SEED,
     intervals: bool = INTERVALS,
@@ -184,7 +195,7 @@ def translate_file_cmd(
                                        help="Seconds per Spot check against a reference."),
     progress: bool = typer.Option(True, "--progress/--no-progress",
                                   help="Show a progress bar on stderr."),
-    server: str = SERVER,
+    server: Server = SERVER,
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
     """Translate a file of instructions as ara translate would, loading the model once.
@@ -282,14 +293,15 @@ def ablation_cmd(
         help="With --data: a file of pairs in the same format to draw worked examples "
              "from (lines whose sentence is a test are left out). Default: the "
              "compositional train side, in your lines' form."),
-    form: str | None = typer.Option(
+    form: Form | None = typer.Option(
         None, "--form",
-        help="lifted or grounded (default: lifted; with --data, every line)."),
+        help="lifted (placeholder names prop_1, ...) or grounded (the sentence's own names) "
+             "[default: lifted; with --data, every line]."),
     variants: str = typer.Option("F,F+P,F+P+C", "--variants",
                                  help="Comma list of variants: letters F, P, C joined by "
                                       "+, or none (zero-shot, unconstrained)."),
     shots: str = typer.Option("5,20", "--shots", help="Comma list of few-shot counts."),
-    examples_by: str = typer.Option(
+    examples_by: ExamplesBy = typer.Option(
         "random", "--examples-by",
         help="How the F variants' worked examples are chosen: random (drawn with --seed, "
              "the same for every test pair of a rerun) or similar (for each test pair, "
@@ -304,14 +316,14 @@ def ablation_cmd(
                                        help="Seconds per Spot check before 'undecided'."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
-    server: str = typer.Option("openai", "--server", help=SERVER_HELP),
+    server: Server = SERVER,
     concurrency: int = typer.Option(
         1, "--concurrency",
         help="Requests in flight at once, for an http(s):// --model (the server batches "
              "them); samples are still written in order, and --resume works as usual."),
     repair: int = typer.Option(0, "--repair", help="Constrained variants: "
                                + REPAIR_HELP["samples"] + " 0 (the paper's variants): greedy."),
-    repair_by: str = REPAIR_BY_OPTION,
+    repair_by: RepairBy = REPAIR_BY_OPTION,
     doubt: float = DOUBT_OPTION,
 ) -> None:
     """Run the F/P/C ablation and write samples, results, tables and a plot to --out."""
@@ -422,7 +434,8 @@ def ceiling_cmd(
     split: str = typer.Option("paper", "--split",
                               help="paper, disjoint, timed, compositional or a hand-written "
                                    "suite (handwritten, handwritten2, ...)."),
-    form: str = typer.Option("lifted", "--form", help="lifted or grounded."),
+    form: Form = typer.Option("lifted", "--form",
+                             help="lifted or grounded."),
     limit: int = typer.Option(0, "--limit", min=0,
                               help="Measure the sample an ablation with this --limit and "
                                    "--seed scores (0: the whole test side)."),

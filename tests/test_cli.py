@@ -261,7 +261,7 @@ def test_explain_reads_a_formula_back_in_english():
         (["eval", "translate", "always (prop_1)", "--aps", "prop_1", "--samples", "3",
           "--repair", "2"], "pass one"),
         (["eval", "translate", "always (prop_1)", "--aps", "prop_1", "--repair-by", "votes"],
-         "--repair-by 'votes'? choose one of samples+edits, edits, samples"),
+         "'votes' is not one of 'samples+edits', 'edits', 'samples'"),
     ],
 )
 def test_translate_refuses_a_request_it_cannot_honour(args, message):
