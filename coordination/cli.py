@@ -49,14 +49,13 @@ def exp2_cmd(
     trials: int = typer.Option(100, "--trials", min=1, help="Number of trials."),
     seed: int = typer.Option(3000, "--seed", help="Seed of trial 0; trial i uses seed + i."),
     planner: Planner = typer.Option("dp", "--planner",
-                                help="dp (exact, fast) or milp (the STL->MILP compiler)."),
+                                    help="dp (exact, fast) or milp (the STL->MILP compiler)."),
     llm: str = typer.Option("none", "--llm",
                             help="none: helpers use the template help spec; else a model "
                                  "(finetuned, finetuned-paper, default, lora:FILE.gguf, "
                                  "FILE.gguf, hf:DIR or an http(s):// endpoint) that translates "
                                  "each request (needs --planner milp)."),
-    solver: Solver = typer.Option("highs", "--solver",
-                               help="MILP solver: highs or gurobi."),
+    solver: Solver = typer.Option("highs", "--solver", help="MILP solver: highs or gurobi."),
     objective: Objective = typer.Option(
         "paper", "--objective",
         help="What a helper minimizes: paper (path length + when the requester's wait ends + "
@@ -127,11 +126,10 @@ def plan_cmd(
     world_file: Path = typer.Option(
         None, "--world",
         help="Grid file: one line a row, '.' free, '#' obstacle [default: the paper's 8x8]."),
-    objective: Objective = typer.Option("makespan", "--objective",
-                                  help="makespan, paper or authors (as ara coord exp2's)."),
+    objective: Objective = typer.Option(
+        "makespan", "--objective", help="makespan, paper or authors (as ara coord exp2's)."),
     cap: int = typer.Option(None, "--cap", min=0, help="Largest makespan allowed."),
-    solver: Solver = typer.Option("highs", "--solver",
-                               help="highs or gurobi."),
+    solver: Solver = typer.Option("highs", "--solver", help="highs or gurobi."),
     as_json: bool = typer.Option(False, "--json", help="One JSON object."),
 ) -> None:
     """Plan a robot's path for an STL spec with the event MILP (no plan: exit 1)."""

@@ -66,8 +66,7 @@ ANY_BOUND = typer.Option(
 TEMPERATURE = typer.Option(0.7, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
                              f"{DEFAULT_REPAIR} (0 where answers are voted); 0: off.")
-REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by",
-                                help=REPAIR_HELP["by"])
+REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])
 DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
@@ -434,8 +433,7 @@ def ceiling_cmd(
     split: str = typer.Option("paper", "--split",
                               help="paper, disjoint, timed, compositional or a hand-written "
                                    "suite (handwritten, handwritten2, ...)."),
-    form: Form = typer.Option("lifted", "--form",
-                             help="lifted or grounded."),
+    form: Form = typer.Option("lifted", "--form", help="lifted or grounded."),
     limit: int = typer.Option(0, "--limit", min=0,
                               help="Measure the sample an ablation with this --limit and "
                                    "--seed scores (0: the whole test side)."),
