@@ -29,18 +29,13 @@ coord_app = typer.Typer(help="Multi-robot help requests: Experiment 2, demos, pl
 
 
 def _translator(llm: str):
-    """None for --llm none; else the eval translator over that model."""
+    """None for --model none; else the eval translator over that model."""
     if llm == "none":
         return None
-    from ara.eval.translate.backends.base import BackendError
     from ara.eval.translate.models import shared_backend
     from ara.eval.translate.translator import Translator
 
-    try:
-        return Translator(shared_backend(llm))
-    except BackendError as err:  # its message names --model, this command's option --llm
-        raise BackendError(str(err).replace("--model", "--llm").replace(
-            "names no model: use", "names no model: use none,")) from err
+    return Translator(shared_backend(llm))
 
 
 @coord_app.command("exp2")
@@ -50,7 +45,7 @@ def exp2_cmd(
     seed: int = typer.Option(3000, "--seed", help="Seed of trial 0; trial i uses seed + i."),
     planner: Planner = typer.Option("dp", "--planner",
                                     help="dp (exact, fast) or milp (the STL->MILP compiler)."),
-    llm: str = typer.Option("none", "--llm",
+    llm: str = typer.Option("none", "--model", "--llm", metavar="none|MODEL",
                             help="none: helpers use the template help spec; else a model "
                                  "(finetuned, finetuned-paper, default, lora:FILE.gguf, "
                                  "FILE.gguf, hf:DIR or an http(s):// endpoint) that translates "
@@ -76,7 +71,7 @@ def exp2_cmd(
     wordings: Wordings = typer.Option(
         "paper", "--wordings",
         help="paper: every trial's request in the paper's words; all: trial i in wording "
-             "i mod 11 (the paper's and ten rewordings), to test a translator (--llm)."),
+             "i mod 11 (the paper's and ten rewordings), to test a translator (--model)."),
     processes: int = typer.Option(1, "--processes", min=1,
                                   help="Trials run in parallel (joblib processes)."),
 ) -> None:
@@ -102,9 +97,9 @@ def exp2_cmd(
 def demo_cmd(
     name: str = typer.Argument(..., metavar="NAME", help="pallet, kitting or tool."),
     out: Path = typer.Option(Path("runs/demos"), "--out", help="Folder for the PNG and JSON."),
-    llm: str = typer.Option("none", "--llm",
+    llm: str = typer.Option("none", "--model", "--llm", metavar="none|MODEL",
                             help="none: the reference STL; else a model that translates "
-                                 "(as --llm of ara coord exp2)."),
+                                 "(as --model of ara coord exp2)."),
 ) -> None:
     """Run one of the paper's demonstrations: messages, STL, plan, and a PNG of the paths."""
     from ara.coordination.demos import DEMOS, run_demo

@@ -7,7 +7,7 @@
 - ``tool``: a strict sequence through nested U (key from the cabinet, then the tool
   from the locker, then the workbench).
 
-Each prints the messages, the STL (the translator's when ``--llm`` names a model, the
+Each prints the messages, the STL (the translator's when ``--model`` names a model, the
 reference formula otherwise), the plan, and writes a PNG of the paths.
 """
 
@@ -44,7 +44,7 @@ class Errand:
     nl: str
     start: Cell
     places: dict[str, Cell]
-    reference: str  # the formula the instruction means, for --llm none
+    reference: str  # the formula the instruction means, for --model none
 
 
 ERRANDS = {

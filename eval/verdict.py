@@ -13,7 +13,7 @@ into one folder; ``ara eval verdict FOLDER --judge SUITE`` reads it and checks, 
 3. the help request (``bench/help_request_wordings.py``), which the coordination half
    depends on: at most ``help_misses`` fewer wordings equivalent to the template's spec;
 4. the help request where it counts, in the paper's Experiment 2 with the candidate
-   translating every request (``ara coord exp2 --llm ... --wordings all``): no auction
+   translating every request (``ara coord exp2 --model ... --wordings all``): no auction
    whose outcome differs from the one the template's spec gives, none left unanswered;
 5. no more invalid answers than the shipped file (under the grammar, both give none).
 

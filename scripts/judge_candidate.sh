@@ -105,7 +105,7 @@ help_of "$model" help-request-wordings.json
 help_of finetuned help-request-wordings-shipped.json
 step "Experiment 2, the candidate translating every request (its auctions against the template's)"
 run .venv/bin/ara coord exp2 --out "runs/generalization/$root/exp2-candidate" --planner milp \
-  --llm "$model" --wordings all
+  --model "$model" --wordings all
 if [ "${PAPER:-1}" != 0 ]; then
   step "the paper split, lifted test side, repair 8"
   run .venv/bin/ara eval ablation --split paper --form lifted --limit 3000 --model "$model" \

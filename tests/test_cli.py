@@ -154,7 +154,7 @@ def test_stl_help_gives_the_syntax():
      (["eval", "ablation", "--out", "unused", "--reruns", "0"], "--reruns"),
      (["coord", "exp2", "--out", "unused", "--processes", "0"], "--processes"),
      (["coord", "exp2", "--out", "unused", "--objective", "fastest"], "--objective"),
-     (["coord", "demo", "dance", "--llm", "not-a-model"], "unknown demo 'dance'"),
+     (["coord", "demo", "dance", "--model", "not-a-model"], "unknown demo 'dance'"),
      (["demo", "--n", "0", "--model", "not-a-model"], "--n"),
      (["translate", "go to the kitchen", "--aps", "Bad-Name", "--model", "not-a-model"],
       "'Bad-Name' is not a valid name"),
@@ -167,6 +167,15 @@ def test_bad_input_is_one_line_of_error_and_exit_2_before_any_model_loads(args, 
     out = ara(*[str(tmp_path / a) if a == "unused" else a for a in args])
     assert out.returncode == 2 and says in out.stderr + out.stdout, out.stderr
     assert "Traceback" not in out.stderr and not (tmp_path / "unused").exists()
+
+
+def test_coord_names_its_model_as_every_command_does(tmp_path):
+    """--model, as in ara translate, with the same error for a name that is no model;
+    --llm, its earlier name, still works."""
+    for option in ("--model", "--llm"):
+        out = ara("coord", "demo", "tool", "--out", str(tmp_path), option, "not-a-model")
+        assert out.returncode == 2, out.stderr
+        assert "--model 'not-a-model' names no model" in out.stderr, out.stderr
 
 
 def test_a_config_that_is_not_a_yaml_mapping_is_named(tmp_path):
