@@ -20,12 +20,10 @@ from tqdm import tqdm
 
 from ara.coordination.protocol import REQUEST_WORDINGS, request_shots, request_text
 from ara.coordination.world import GridWorld
-from ara.data.help_requests import help_props, template_help_spec
+from ara.data.help_requests import help_props, says_template
 from ara.eval.translate.models import make_backend
 from ara.eval.translate.repair import translate_repaired
 from ara.eval.translate.translator import Translator
-from ara.grammars import parse
-from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
 
 CAPS = ("navigate", "report conflicts")
 
@@ -49,11 +47,7 @@ def main() -> None:
         vote = translate_repaired(translator, text, help_props(site, drop),
                                   request_shots())  # repaired as a helper reads it
         result = vote.result
-        try:
-            same = equivalent(parse(result.stl), template_help_spec(site, drop, ()),
-                              timeout_s=30)
-        except SpotTimeoutError:
-            same = None
+        same = says_template(result.stl, site, drop)
         rows.append({"wording": wording, "site": list(site), "stl": result.stl,
                      "equivalent": same, "ms": round(vote.ms, 1),
                      "answers_weighed": len(vote.results)})

@@ -62,7 +62,8 @@ def exp2_cmd(
     instances: Instances = typer.Option(
         "paper", "--instances",
         help="paper: trials drawn as the authors' code draws them (seeds 3000..3099 give "
-             "the paper's instances); uniform: this project's earlier generator."),
+             "the paper's instances); uniform: the same distribution from one unbroken "
+             "random stream."),
     wait: Wait = typer.Option(
         "arrival", "--wait",
         help="When the requester's wait ends: arrival (the helper reaches the site, the "
@@ -73,7 +74,8 @@ def exp2_cmd(
         help="paper: every trial's request in the paper's words; all: trial i in wording "
              "i mod 11 (the paper's and ten rewordings), to test a translator (--model)."),
     processes: int = typer.Option(1, "--processes", min=1,
-                                  help="Trials run in parallel (joblib processes)."),
+                                  help="Trials run in parallel (joblib processes); with "
+                                       "--model, one at a time, over the one loaded model."),
 ) -> None:
     """Reproduce the paper's Experiment 2: trials.csv, summary.json, boxplot.png in OUT."""
     from ara.coordination.experiment2 import Exp2Config, run, table
@@ -135,7 +137,6 @@ def plan_cmd(
     from ara.coordination.milp import make_solver
     from ara.coordination.planner_milp import plan_spec
     from ara.coordination.world import GridWorld
-    from ara.errors import ConfigError
     from ara.grammars import parse
 
     def cell(text: str):

@@ -19,20 +19,12 @@ from pathlib import Path
 from ara.coordination.events import UnsupportedSpec, Vocabulary
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
-from ara.coordination.protocol import (
-    Helper,
-    HelpRequest,
-    help_props,
-    request_text,
-    run_round,
-    template_help_spec,
-)
+from ara.coordination.protocol import Helper, HelpRequest, request_text, run_round
 from ara.coordination.specs import job_names, jobs_vocabulary
 from ara.coordination.world import Cell, GridWorld
-from ara.data.help_requests import pick_ap, place_ap
+from ara.data.help_requests import help_props, pick_ap, place_ap, says_template
 from ara.errors import ConfigError
 from ara.grammars import parse
-from ara.grammars.spot_bridge import equivalent
 
 DEMOS = ("pallet", "kitting", "tool")
 
@@ -90,12 +82,12 @@ def _pallet(world: GridWorld, translator, echo) -> dict:
     rnd = run_round(world, request, helpers, planner="milp", translator=translator)
     paths = {"requester": [requester]}
     drop = world.nearest_free_neighbour(site)
-    template = template_help_spec(site, drop, ())
     for o in rnd.offers:
         verdict = ""
         if translator is not None:  # without one, every helper plans the template itself
-            same = bool(o.stl) and equivalent(parse(o.stl), template, timeout_s=10)
-            verdict = f"  (pick-before-place template: {'equivalent' if same else 'differs'})"
+            same = bool(o.stl) and says_template(o.stl, site, drop, timeout_s=10)
+            said = {True: "equivalent", False: "differs", None: "Spot cannot tell"}[same]
+            verdict = f"  (pick-before-place template: {said})"
         echo(f"[forklift {o.helper}] STL: {o.stl or '-'}{verdict}")
         echo(f"[forklift {o.helper}] {o.text}")
     for d in rnd.decisions:

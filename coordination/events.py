@@ -36,6 +36,7 @@ from ara.coordination.world import Cell
 from ara.errors import AraError
 from ara.grammars import Always, And, Atom, Const, Eventually, Formula, Implies, Not, Or, Until
 from ara.grammars import to_text as stl_text
+from ara.grammars.ast import conjuncts as and_operands
 
 START = "start"
 
@@ -173,7 +174,7 @@ def _compile(f: Formula, anchor: str, program: EventProgram, vocab: Vocabulary,
 def _visit(f: Formula, anchor: str, lo: int, hi: int | None, program: EventProgram,
            vocab: Vocabulary, pending: list, group: str) -> str:
     """``f`` holds lo..hi steps after the anchor: its head event, then the rest."""
-    parts = f.args if isinstance(f, And) else (f,)
+    parts = and_operands(f)  # the grammar writes two per &: (a & b) & c is a & b & c
     heads = [p for p in parts if isinstance(p, Atom) and p.name in vocab.events]
     if not heads:
         raise UnsupportedSpec(f"{stl_text(f)!r} names no event the robot can do "
@@ -200,8 +201,7 @@ def _always(f: Always, anchor: str, program: EventProgram, vocab: Vocabulary,
     if isinstance(body, Implies) and isinstance(body.lhs, Atom) and body.lhs.name in vocab.events:
         pending.append((group, body.lhs.name, body.rhs))
         return
-    parts = body.args if isinstance(body, And) else (body,)
-    for p in parts:
+    for p in and_operands(body):
         if isinstance(p, Atom) and p.name in vocab.invariants:
             continue
         if isinstance(p, Not) and isinstance(p.arg, Atom) and p.arg.name in vocab.regions:

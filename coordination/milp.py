@@ -7,7 +7,8 @@ present. Its pip license is limited to 2,000 variables and constraints, which th
 event-based plans stay far below.
 
 A solver never raises on an infeasible or unfinished model: the status says so, and
-callers turn anything but ``optimal`` into "cannot help".
+callers plan with any status that carries a solution
+(:data:`ara.coordination.status.WITH_SOLUTION`) and turn the others into "cannot help".
 """
 
 from __future__ import annotations

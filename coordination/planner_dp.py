@@ -46,6 +46,11 @@ class Job:
     dwell: int = 0
     name: str = ""
 
+    def __post_init__(self) -> None:
+        if self.dwell < 0:
+            raise ConfigError(f"job {self.name or (self.pick, self.drop)}: dwell must be "
+                              f">= 0 steps, got {self.dwell}")
+
 
 @dataclass(frozen=True)
 class Plan:

@@ -13,9 +13,9 @@ and the spec adds:
   "no y between a and b" is a disjunction (y before a, or after b) with one binary.
 
 Objectives (Sec. IV of the paper; D = legs travelled, M = makespan):
-``makespan`` M; ``paper`` D + T(help) + M; ``authors`` M + D. The formulation has a
-few dozen binaries where the authors' grid x time model had thousands; HiGHS solves
-the paper's instances in milliseconds, and every optimum is tested against the DP.
+``makespan`` M; ``paper`` D + T(help) + M; ``authors`` M + D. Binaries are per pair of
+events, not per cell and step as in the authors' grid x time model, and the tests hold
+every optimum against the DP's.
 """
 
 from __future__ import annotations

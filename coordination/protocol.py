@@ -7,9 +7,10 @@ offers ``tau_help`` (when the requester's wait ends) and ``tau_new`` (what helpi
 adds to its own makespan). The requester accepts argmin(tau_help + tau_new), ties to
 the lowest id, and rejects the others.
 
-Messages are typed records that carry their NL text. NL comes from a template, or
-from an LLM under a grammar whose literal parts are the required fields (location,
-capabilities, the two numbers), so a generated message cannot lose them.
+Messages are typed records that carry their NL text. Offers and decisions are written
+from templates; a request from a template too, or by an LLM under a grammar whose
+literal parts are the fields the helpers need (location, capabilities), so a generated
+request cannot lose them.
 """
 
 from __future__ import annotations
@@ -231,7 +232,7 @@ class HelpRound:
 
 def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: str = "dp",
                objective: str = "paper", cap: int | None = 50, translator=None,
-               shots: Sequence | None = None, solver: MILPSolver | None = None,
+               solver: MILPSolver | None = None,
                help_formula: Formula | None = None) -> Offer:
     """A helper reads the request, writes its STL, plans, and bids.
 
@@ -239,7 +240,7 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     is its translation, repaired as ``ara translate`` repairs it (logged in the offer,
     right or wrong, and planned as it says); with ``help_formula`` it is that formula
     (over :func:`help_props`); otherwise it is the template spec. The DP planner
-    handles the template spec only. ``shots`` default to :func:`request_shots`.
+    handles the template spec only. The translator sees :func:`request_shots`.
     """
     if planner not in PLANNERS:
         raise ProtocolError(f"planner must be one of {PLANNERS}, got {planner!r}")
@@ -270,11 +271,11 @@ def make_offer(world: GridWorld, helper: Helper, request: HelpRequest, planner: 
     if translator is not None:
         from ara.eval.translate.repair import translate_repaired
 
-        shots = request_shots() if shots is None else shots
         # Repaired as `ara translate` repairs, so a helper reads a request as a user's
         # own translation would: the greedy answer unless it leaves part out or the
         # model doubts it.
-        result = translate_repaired(translator, request.text, (pick, place), shots).result
+        result = translate_repaired(translator, request.text, (pick, place),
+                                    request_shots()).result
         if not result.valid:
             return _decline(helper, f"could not translate the request ({result.error})")
         help_formula = parse(result.stl)

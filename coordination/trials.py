@@ -13,15 +13,13 @@ Two ways to draw trial ``s`` (a seed; the paper's run uses 3000..3099):
      ``choices(free, k=4)`` for the drops; jobs are the blocks' pairs in order, and a
      pick may equal its drop.
 
-  Written from this recipe alone, the draw matched the authors' site, starts and jobs
-  in 100 of 100 trials (see ``docs/experiment2-spec.md``).
+  docs/coordination.md says how this was checked against the authors' instances.
 * ``uniform`` draws the same distribution from one unbroken stream (site, then
-  starts, then each job's pick and drop): this project's generator before the recipe
-  above was known.
+  starts, then each job's pick and drop).
 
 The help job's drop cell is the site's nearest free neighbour in a fixed order, for
-both (the authors draw a random neighbour after their Oracle's random calls: no rule
-that a re-draw could follow; matching it moved the means by about 0.1).
+both: the authors draw a random neighbour after their Oracle's random calls, which no
+re-draw can follow.
 """
 
 from __future__ import annotations

@@ -97,7 +97,12 @@ class GridWorld:
         path = Path(path)
         if not path.is_file():
             raise WorldError(f"world file not found: {path}")
-        return cls.from_text(path.read_text(), str(path))
+        try:
+            text = path.read_text(encoding="utf-8")
+        except UnicodeDecodeError:
+            raise WorldError(f"{path} is not a text grid: one line a row, '.' free, "
+                             "'#' obstacle") from None
+        return cls.from_text(text, str(path))
 
     @classmethod
     def paper(cls) -> GridWorld:

@@ -130,3 +130,17 @@ def template_help_spec(site: Cell, drop: Cell, others: Sequence[str]) -> Formula
     spec = rename_atoms(pnp_spec("h", others), {pick_ap("h"): pick, place_ap("h"): place})
     first, second, third = spec.args
     return And((And((first, second)), third))
+
+
+def says_template(stl: str, site: Cell, drop: Cell, timeout_s: float = 30) -> bool | None:
+    """Whether a helper's translation means :func:`template_help_spec` (Spot); None where
+    Spot cannot tell within ``timeout_s`` or the formula's bounds are too large for it, so
+    a trial or a demo records it as unknown instead of stopping."""
+    from ara.errors import BoundTooLargeError
+    from ara.grammars import parse
+    from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
+
+    try:
+        return equivalent(parse(stl), template_help_spec(site, drop, ()), timeout_s=timeout_s)
+    except (SpotTimeoutError, BoundTooLargeError):
+        return None

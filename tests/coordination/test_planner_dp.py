@@ -79,6 +79,11 @@ def test_paper_objective_needs_the_help_job():
         plan_jobs(WORLD, (0, 0), [Job((1, 0), (2, 0))], "paper")
 
 
+def test_a_job_cannot_dwell_a_negative_time():
+    with pytest.raises(ConfigError, match="pallet: dwell must be >= 0"):
+        Job((1, 0), (2, 0), dwell=-1, name="pallet")
+
+
 def test_the_cap_constrains_the_search_not_just_the_answer():
     """Under the paper objective the cheapest order can run past the cap while a dearer
     one fits: the planner must find the dearer one (brute force over orders)."""

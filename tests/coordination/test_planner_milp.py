@@ -4,7 +4,7 @@ import random
 
 import pytest
 
-from ara.coordination.events import UnsupportedSpec, Vocabulary
+from ara.coordination.events import UnsupportedSpec, Vocabulary, compile_spec
 from ara.coordination.milp import HiGHSSolver, LinearModel, make_solver
 from ara.coordination.planner_dp import Job, plan_jobs
 from ara.coordination.planner_milp import plan_spec
@@ -89,6 +89,20 @@ def test_keep_out_regions_lengthen_paths():
     free = plan_spec(PAPER, (0, 0), {"t": parse("F goal")}, vocab)
     around = plan_spec(PAPER, (0, 0), {"t": parse("F goal & G !hall")}, vocab)
     assert free.makespan == 2 and around.makespan == 8  # down column 0, along row 3, up
+
+
+@pytest.mark.parametrize(("flat", "nested"), [
+    ("F(a & F b & c)", "F((a & F b) & c)"),
+    ("F a & G(!hall & ok)", "F a & G((!hall & ok) & ok)"),
+    ("F a & F b & G !hall", "(F a & F b) & G !hall"),
+])
+def test_bracketing_of_a_conjunction_changes_no_plan(flat, nested):
+    """The grammar writes two operands to an &, so a model answers ``(x & y) & z`` as
+    often as ``x & y & z``: both are the same program."""
+    vocab = Vocabulary({"a": (0, 2), "b": (7, 7), "c": (0, 2)},
+                       regions={"hall": frozenset({(0, 1)})}, invariants=frozenset({"ok"}))
+    programs = [compile_spec({"t": parse(text)}, vocab) for text in (flat, nested)]
+    assert programs[0] == programs[1] and programs[0].events
 
 
 def test_formulas_outside_the_event_fragment_are_refused_by_name():

@@ -17,7 +17,7 @@ from ara.coordination.protocol import (
     run_round,
 )
 from ara.coordination.world import GridWorld
-from ara.data.help_requests import help_props, template_help_spec
+from ara.data.help_requests import help_props, says_template, template_help_spec
 
 WORLD = GridWorld.paper()
 CAPS = ("navigate", "report conflicts")
@@ -122,14 +122,19 @@ def test_the_shipped_translator_reads_a_reworded_request_as_the_template_spec(
         shipped_translator, wording):
     """Tests that a helper's translation of the request, however worded, is the
     pick-before-place spec the planner would write from the request's fields."""
-    from ara.grammars import parse
-    from ara.grammars.spot_bridge import equivalent
-
     site = (3, 4)
     drop = GridWorld.paper().nearest_free_neighbour(site)
     result = shipped_translator.translate(request_text(site, CAPS, wording=wording),
                                           help_props(site, drop), request_shots())
-    assert equivalent(parse(result.stl), template_help_spec(site, drop, ()), timeout_s=30)
+    assert says_template(result.stl, site, drop)
+
+
+def test_a_translation_says_the_template_or_not_whatever_its_bracketing():
+    site, drop = (3, 4), (2, 4)
+    pick, place = help_props(site, drop)
+    assert says_template(f"(!{place} U {pick}) & (G({pick} -> F {place}) & F {place})",
+                         site, drop)
+    assert says_template(f"F {pick} & F {place}", site, drop) is False
 
 
 def test_a_helper_given_the_bare_help_spec_still_carries_one_pallet_at_a_time():

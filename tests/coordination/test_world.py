@@ -53,3 +53,11 @@ def test_missing_world_file(tmp_path):
     """Tests the message for a path that does not exist."""
     with pytest.raises(WorldError, match="world file not found"):
         GridWorld.from_file(tmp_path / "none.txt")
+
+
+def test_a_world_file_that_is_not_text(tmp_path):
+    """Tests that a picture given as --world is refused by name, not with a traceback."""
+    png = tmp_path / "map.png"
+    png.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")
+    with pytest.raises(WorldError, match="map.png is not a text grid"):
+        GridWorld.from_file(png)
