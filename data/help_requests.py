@@ -136,11 +136,7 @@ def says_template(stl: str, site: Cell, drop: Cell, timeout_s: float = 30) -> bo
     """Whether a helper's translation means :func:`template_help_spec` (Spot); None where
     Spot cannot tell within ``timeout_s`` or the formula's bounds are too large for it, so
     a trial or a demo records it as unknown instead of stopping."""
-    from ara.errors import BoundTooLargeError
-    from ara.grammars import parse
-    from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
+    from ara.grammars import to_text
+    from ara.grammars.spot_bridge import same_meaning
 
-    try:
-        return equivalent(parse(stl), template_help_spec(site, drop, ()), timeout_s=timeout_s)
-    except (SpotTimeoutError, BoundTooLargeError):
-        return None
+    return same_meaning(stl, to_text(template_help_spec(site, drop, ())), timeout_s)

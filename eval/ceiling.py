@@ -21,8 +21,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from ara.data.normalize import Record
-from ara.grammars import parse
-from ara.grammars.spot_bridge import equivalent
+from ara.grammars.spot_bridge import same_meaning
 
 Key = tuple[str, tuple[str, ...]]
 
@@ -77,12 +76,7 @@ def _classes(labels: Sequence[str], same: Callable[[str, str], bool]) -> list[li
 def spot_equivalent(a: str, b: str, timeout_s: float = 10.0) -> bool:
     """Equal texts, or formulas Spot proves equivalent (an undecided check counts as
     different, which can only lower the ceiling)."""
-    if a == b:
-        return True
-    try:
-        return equivalent(parse(a), parse(b), timeout_s=timeout_s)
-    except TimeoutError:
-        return False
+    return same_meaning(a, b, timeout_s) is True
 
 
 def label_ceiling(test: Sequence[Record], train: Sequence[Record],

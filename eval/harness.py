@@ -20,6 +20,7 @@ from typing import Protocol
 
 from ara import __version__
 from ara.data import Record
+from ara.data.mixture import sentence_key
 from ara.data.store import FORMS, SPLITS
 from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
 from ara.eval.translate.answering import Answer
@@ -226,8 +227,8 @@ def shot_pool(config: AblationConfig, split: Split) -> list[Record]:
     forms = Counter(r.form for r in split.records("test", config.form))
     form = config.form or max(FORMS, key=lambda f: forms[f])
     pool = load_or_prepare("compositional", config.data_seed).records("train", form)
-    tests = {r.nl for r in split.records("test")}
-    return [r for r in pool if r.nl not in tests]
+    tests = {sentence_key(r.nl) for r in split.records("test")}  # "Go." is the test "go"
+    return [r for r in pool if sentence_key(r.nl) not in tests]
 
 
 def plan(config: AblationConfig, split: Split) -> Iterator[Job]:

@@ -100,17 +100,19 @@ def _variant_order(name: str) -> tuple[int, str]:
 
 
 def overhead(results: list[VariantResult]) -> dict[str, float]:
-    """Constrained-vs-unconstrained latency ratio at each shot count: X+C over X.
+    """Constrained-vs-unconstrained latency ratio at each shot count: X+C over X, and C
+    over none.
 
     Returns:
-        ``{"F+P+C / F+P @ 5 shots": 1.03, ...}`` for every pair present.
+        ``{"F+P+C / F+P @ 5 shots": 1.03, "C / none @ 0 shots": 1.1, ...}`` for every pair
+        present.
     """
     by_key = {(r["variant"], r["shots"]): r["latency_ms"]["mean"] for r in results}
     ratios = {}
     for (variant, shots), ms in sorted(by_key.items()):
         if variant.endswith("+C") or variant == "C":
-            base = variant[:-2] if variant.endswith("+C") else None
-            if base and (base, shots) in by_key and by_key[(base, shots)]:
+            base = variant[:-2] if variant.endswith("+C") else "none"
+            if (base, shots) in by_key and by_key[(base, shots)]:
                 ratios[f"{variant} / {base} @ {shots} shots"] = round(ms / by_key[(base, shots)], 3)
     return ratios
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ara.data import Record
+from ara.data.mixture import sentence_key
 from ara.errors import ConfigError
 from ara.eval.translate.request_file import read_pairs
 from ara.eval.translate.translator import TranslatorConfig
@@ -64,8 +65,8 @@ def file_split(data: Path, examples: Path | None, config: TranslatorConfig) -> F
     files = {str(data): _sha256(data)}
     train: list[Record] = []
     if examples is not None:
-        sentences = {r.nl for r in tests}
-        train = [r for r in read_pairs(examples, config) if r.nl not in sentences]
+        sentences = {sentence_key(r.nl) for r in tests}  # "Go." is the test "go"
+        train = [r for r in read_pairs(examples, config) if sentence_key(r.nl) not in sentences]
         files[str(examples)] = _sha256(examples)
         if not train:
             raise ConfigError(f"{examples} holds no pair whose sentence is not also in {data}: "

@@ -209,6 +209,18 @@ def judge(reference: str, output: str | None, timeout_s: float) -> dict:
         return {"equivalent": None, "implies": None, "spot": "bound"}
 
 
+def same_meaning(a: str, b: str, timeout_s: float | None) -> bool | None:
+    """Whether two formulas' texts mean the same: equal texts without Spot, else Spot's
+    verdict; None where Spot cannot tell (``timeout_s`` passed, or a bound is beyond
+    :data:`SPOT_MAX_BOUND`), which each caller weighs as its purpose needs."""
+    if a == b:  # one canonical text is one tree
+        return True
+    try:
+        return equivalent(parse(a), parse(b), timeout_s=timeout_s)
+    except (SpotTimeoutError, BoundTooLargeError):
+        return None
+
+
 def _decide(op: str, a: str, b: str, timeout_s: float | None) -> bool:
     if timeout_s is None:
         return (_equivalent if op == "equivalent" else _implies)(a, b)

@@ -37,7 +37,7 @@ from ara.eval.translate.prompt import Shot
 from ara.eval.translate.request import Request
 from ara.eval.translate.translator import ANSWER_PREFIX, TranslationResult, Translator
 from ara.grammars import parse, to_text
-from ara.grammars.spot_bridge import SpotTimeoutError, equivalent
+from ara.grammars.spot_bridge import same_meaning
 
 #: Repair in ``ara translate`` and ``ara demo``: on, drawing this many answers. What
 #: each way of repairing fixed and broke on the held-out sets: docs/what-moved.md.
@@ -391,12 +391,11 @@ def _group(answers: Sequence[str | None], timeout_s: float,
 
 def _same(a: str, b: str, timeout_s: float, deadline: Deadline = UNBOUNDED) -> bool:
     """Whether Spot finds ``a`` and ``b`` the same within ``timeout_s`` and ``deadline``."""
-    if a == b:  # canonical texts: equal text, equal tree
+    if a == b:
         return True
     if deadline.spent():
         return False
-    try:
-        return equivalent(parse(a), parse(b), timeout_s=deadline.within(timeout_s))
-    except SpotTimeoutError:
+    same = same_meaning(a, b, deadline.within(timeout_s))
+    if same is None:
         deadline.spent()  # the budget, not the check's own limit, may have stopped it
-        return False
+    return same is True

@@ -70,9 +70,11 @@ def test_shot_counts_are_separate_runs():
 
 
 def test_overhead_pairs_each_constrained_variant_with_its_twin():
-    """Tests the latency ratio F+P+C / F+P."""
-    samples = [sample("F+P", "a", True, True, ms=200.0), sample("F+P+C", "a", True, True, ms=210.0)]
-    assert overhead(score(samples)) == {"F+P+C / F+P @ 5 shots": 1.05}
+    """Tests the latency ratios F+P+C / F+P and C / none (decoding alone)."""
+    samples = [sample("F+P", "a", True, True, ms=200.0), sample("F+P+C", "a", True, True, ms=210.0),
+               sample("none", "a", True, True, ms=100.0), sample("C", "a", True, True, ms=120.0)]
+    assert overhead(score(samples)) == {"F+P+C / F+P @ 5 shots": 1.05,
+                                        "C / none @ 5 shots": 1.2}
 
 
 def test_gap_precision_counts_flagged_references_and_right_or_wrong_answers():

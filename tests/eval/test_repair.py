@@ -34,6 +34,8 @@ def test_answers_group_by_meaning_not_by_text():
     """Tests that Spot-equivalent spellings share a group and unparsed answers stand alone."""
     answers = ("F(a) | F(b)", "G(a)", "F(a | b)", None, "G(a)")
     assert _group(answers, timeout_s=10) == [(0, 2), (1, 4), (3,)]
+    # A bound Spot cannot check (--max-bound lets a user allow one) stands alone.
+    assert _group(("F[0,1500](a)", "F(a)"), timeout_s=10) == [(0,), (1,)]
 
 
 def _answer(stl: str) -> TranslationResult:

@@ -80,6 +80,11 @@ def test_worked_examples_never_show_a_test_sentence(tmp_path):
     assert split.records("test", "lifted") == []
     with pytest.raises(ConfigError, match="would show the answers"):
         file_split(tests, tests, TranslatorConfig())
+    # Nor the same sentence written another way (case, spacing, a full stop).
+    shouted = [{**p, "nl": "  " + p["nl"].upper().rstrip(".")} for p in PAIRS[:2]]
+    split = file_split(tests, write(tmp_path / "shouted.jsonl", [*shouted, PAIRS[2]]),
+                       TranslatorConfig())
+    assert [r.nl for r in split.records("train")] == [PAIRS[2]["nl"]]
 
 
 def test_the_version_is_the_content_not_the_name(tmp_path):

@@ -17,6 +17,7 @@ from ara.grammars.spot_bridge import (
     accepts_word,
     equivalent,
     implies,
+    same_meaning,
     to_spot_text,
 )
 
@@ -73,6 +74,15 @@ def test_bounds_past_the_limit_raise_a_clear_error():
         equivalent(big, parse("F(a)"))
     with pytest.raises(BoundTooLargeError):
         implies(parse("a"), big)
+
+
+def test_same_meaning_says_none_where_spot_cannot_tell():
+    """Tests the one comparison repair, the ceiling and the help protocol share: a
+    bound past Spot's limit is undecided, not an error after the model has answered."""
+    assert same_meaning("F(a)", "F(a)", timeout_s=10) is True
+    assert same_meaning("G(F(a))", "F(G(a))", timeout_s=10) is False
+    assert same_meaning("a & b", "b & a", timeout_s=10) is True
+    assert same_meaning(f"F[0,{SPOT_MAX_BOUND + 500}](a)", "F(a)", timeout_s=10) is None
 
 
 letters = st.frozensets(st.sampled_from(["a", "b"]))
