@@ -309,15 +309,17 @@ def ablation_cmd(
     limit: int = typer.Option(1000, "--limit", min=1, help="Test pairs to sample."),
     seed: int = typer.Option(0, "--seed", help="Seeds the test sample and the examples."),
     model: str = typer.Option("default", "--model", help=MODEL_HELP),
-    mask: str = typer.Option("llguidance", "--mask",
-                             help="Constraint engine: llguidance (fast) or llama (built-in)."),
+    mask: str = typer.Option("llguidance", "--mask", metavar="ENGINE",
+                             help="Constraint engine of a local model: llguidance (fast, "
+                                  "any), llama (llama.cpp's built-in, GGUF) or outlines "
+                                  "(hf:); a server uses its own."),
     spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
                                        help="Seconds per Spot check before 'undecided'."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
     server: Server = SERVER,
     concurrency: int = typer.Option(
-        1, "--concurrency",
+        1, "--concurrency", min=1,
         help="Requests in flight at once, for an http(s):// --model (the server batches "
              "them); samples are still written in order, and --resume works as usual."),
     repair: int = typer.Option(0, "--repair", help="Constrained variants: "

@@ -154,6 +154,9 @@ class AblationConfig:
             raise ConfigError(f"reruns: at least 1, got {self.reruns}")
         if self.limit < 1:
             raise ConfigError(f"limit: at least 1 test pair, got {self.limit}")
+        if not self.spot_timeout_s > 0:
+            raise ConfigError(f"spot_timeout_s: seconds per Spot check, > 0; got "
+                              f"{self.spot_timeout_s}")
         if self.repair.samples is None:  # an ablation states its repair: none by default
             raise ConfigError("repair.samples: name the answers to draw, 0 to 32 (0: off)")
         if self.examples_by not in EXAMPLES_BY:

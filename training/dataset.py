@@ -18,8 +18,7 @@ import torch
 
 from ara.data.normalize import Record
 from ara.errors import ConfigError
-from ara.eval.translate.prompt import STOP, Shot, build_prompt
-from ara.eval.translate.translator import ANSWER_PREFIX
+from ara.eval.translate.prompt import ANSWER_PREFIX, STOP, Shot, build_prompt
 from ara.kv_cache import cache_of, with_cache
 from ara.output_layer import output_rows
 

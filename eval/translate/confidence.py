@@ -6,9 +6,8 @@ answers well on the held-out sets (measured in docs/model-card.md, "How repair a
 confidence note work"); a sentence the model cannot read ("( prop_1 ) purple elephant
 ( prop_2 )") gets a low one.
 
-It mostly flags: the model seldom scores the reference above its own wrong answer, and
-keeping the majority of samples where it doubts did worse than the greedy answer. Where
-it does, greedy decoding missed a likelier answer, and repair looks for it: where the
+It mostly flags: the model seldom scores the reference above its own wrong answer.
+Where it does, greedy decoding missed a likelier answer, and repair looks for it: where the
 model doubts a complete answer, it keeps the best-scored of it and the samples
 (:func:`~ara.eval.translate.repair.translate_repaired`). A user who sees the flag reads the
 answer back (`ara stl explain`) or rewords the sentence.

@@ -3,7 +3,7 @@
 * ``default``: the embedded Gemma 3 270M Q4_K_M GGUF, through llama.cpp;
 * ``finetuned``: the shipped fine-tune (``eval/models/``, trained on the compositional
   mixture) on the embedded base;
-* ``finetuned-paper``: the earlier adapter, trained on the paper split alone (Table I);
+* ``finetuned-paper``: an adapter trained on the paper split alone (Table I);
 * ``lora:PATH``: a GGUF LoRA adapter (``ara export --lora-gguf``) on the embedded base;
 * a path ending in ``.gguf``: that file, through llama.cpp (exported fine-tunes, Gemma 3
   12B on a bigger machine);
@@ -11,6 +11,10 @@
   already in the local cache: nothing is downloaded);
 * ``http://...`` or ``https://...``: an OpenAI-compatible endpoint; constrained
   decoding where ``server`` names a server that reads grammars (llama, vllm, sglang).
+  What follows ``#`` is the model name sent (``default`` without one, the name vLLM and
+  SGLang serve with ``--served-model-name default``); ``#chat:NAME`` sends the prompt as
+  one user message to the chat API, for chat models such as the paper's GPT-4 baseline
+  (``https://api.openai.com#chat:gpt-4``, the key in ``$OPENAI_API_KEY``).
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ def default_shots(model: str) -> int:
 
 
 def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
-                 api_model: str | None = None, server: str = "openai") -> Backend:
+                 server: str = "openai") -> Backend:
     """The backend for a ``--model`` value (see the module doc).
 
     Raises:
@@ -60,7 +64,11 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     if model.startswith(("http://", "https://")):
         from ara.eval.translate.backends.openai_http import OpenAIBackend
 
-        return OpenAIBackend(model, api_model or "default", server=server)
+        url, _, name = model.partition("#")
+        api, chat_name = "chat", name.removeprefix("chat:")
+        if chat_name == name:  # no chat: prefix
+            api = "completions"
+        return OpenAIBackend(url, chat_name or "default", api=api, server=server)
     if model.startswith("hf:"):
         from ara.eval.translate.backends.hf_backend import HFBackend
 
@@ -76,7 +84,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
 
 
 def shared_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
-                   api_model: str | None = None, server: str = "openai") -> Backend:
+                   server: str = "openai") -> Backend:
     """:func:`make_backend`'s backend for these arguments, loaded once per process and
     kept (the four most recent; the same arguments by position, by name or left to
     their defaults are one entry): loading the embedded model and an adapter takes
@@ -90,12 +98,12 @@ def shared_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     Raises:
         BackendError: As :func:`make_backend`.
     """
-    return _shared(model, n_ctx, mask, api_model, server)  # one key however it is called
+    return _shared(model, n_ctx, mask, server)  # one key however it is called
 
 
 @lru_cache(maxsize=4)
-def _shared(model: str, n_ctx: int, mask: str, api_model: str | None, server: str) -> Backend:
-    return make_backend(model, n_ctx=n_ctx, mask=mask, api_model=api_model, server=server)
+def _shared(model: str, n_ctx: int, mask: str, server: str) -> Backend:
+    return make_backend(model, n_ctx=n_ctx, mask=mask, server=server)
 
 
 shared_backend.cache_clear = _shared.cache_clear

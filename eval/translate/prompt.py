@@ -24,6 +24,8 @@ INSTRUCTIONS = (
 )
 #: Ends the answer line; backends stop generating at it when unconstrained.
 STOP = "\n"
+#: The space a model writes after "STL:"; part of the decoding grammar, stripped after.
+ANSWER_PREFIX = " "
 
 
 @dataclass(frozen=True)
@@ -45,7 +47,7 @@ def format_example(nl: str, aps: Sequence[str], stl: str | None = None) -> str:
     The answer follows ``"STL: "``; training puts its loss on the answer alone.
     """
     block = f"NL: {nl}\nPropositions: {', '.join(aps)}\nSTL:"
-    return block if stl is None else f"{block} {stl}{STOP}\n"
+    return block if stl is None else f"{block}{ANSWER_PREFIX}{stl}{STOP}\n"
 
 
 def grammar_for_prompt(syntax: Syntax) -> str:

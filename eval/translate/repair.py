@@ -33,9 +33,9 @@ from ara.eval.translate.backends.base import Sampling
 from ara.eval.translate.checks import gaps, mends
 from ara.eval.translate.confidence import DOUBT, result_score
 from ara.eval.translate.deadline import UNBOUNDED, Deadline
-from ara.eval.translate.prompt import Shot
+from ara.eval.translate.prompt import ANSWER_PREFIX, Shot
 from ara.eval.translate.request import Request
-from ara.eval.translate.translator import ANSWER_PREFIX, TranslationResult, Translator
+from ara.eval.translate.translator import TranslationResult, Translator
 from ara.grammars import parse, to_text
 from ara.grammars.spot_bridge import same_meaning
 
@@ -93,7 +93,7 @@ class RepairConfig:
             raise ConfigError(f"--repair-by {self.by!r}? choose one of {', '.join(REPAIR_BY)}")
         if not 0 <= self.doubt <= 1:
             raise ConfigError(f"doubt is a probability, 0 to 1 (0: gaps only); got {self.doubt}")
-        if self.temperature <= 0:
+        if not 0 < self.temperature < math.inf:  # nan too
             raise ConfigError(f"temperature must be > 0, got {self.temperature}")
 
     @property

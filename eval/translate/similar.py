@@ -6,8 +6,8 @@ What carries an instruction's logic is its wording around the things it names ("
 each sentence is compared with the words of its propositions masked and its numbers
 made one token (:func:`logic_words`). Sentences are TF-IDF vectors of those words and
 their bigrams, compared by cosine similarity through an inverted index: a query reads
-only the postings of its own terms, a millisecond or two over the 12,000 records of the
-training mixture. An index is built once per pool and kept by the pool's content hash,
+only the postings of its own terms, so it stays fast over the whole training mixture.
+An index is built once per pool and kept by the pool's content hash,
 in this process and on disk (``~/.cache/ara/similar``).
 """
 

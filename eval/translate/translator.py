@@ -15,7 +15,14 @@ from functools import lru_cache
 
 from ara.errors import AraError, ConfigError, STLSyntaxError
 from ara.eval.translate.backends.base import Backend, BackendError, Sampling
-from ara.eval.translate.prompt import STOP, Shot, build_prompt, grammar_for_prompt, prompt_sha256
+from ara.eval.translate.prompt import (
+    ANSWER_PREFIX,
+    STOP,
+    Shot,
+    build_prompt,
+    grammar_for_prompt,
+    prompt_sha256,
+)
 from ara.eval.translate.request import Request
 from ara.grammars import (
     BuiltGrammar,
@@ -26,9 +33,6 @@ from ara.grammars import (
     require_literals,
     to_text,
 )
-
-#: The space a model writes after "STL:"; part of the decoding grammar, stripped after.
-ANSWER_PREFIX = " "
 
 
 @dataclass(frozen=True)
@@ -46,11 +50,10 @@ class TranslatorConfig:
         max_bound: Largest interval bound, with ``intervals``.
         bounds_from_request: With ``intervals``: an interval may only use 0 and the
             numbers the instruction writes (digits or words up to "hundred"), and a
-            sentence with no number gets no interval at all. Every reference formula
-            of the NL2TL timed sets and the hand-written suite passes this rule (4
-            noisy training rows of 6,648 do not), and the grammar stays a few rules
-            instead of two per number up to ``max_bound``, so it compiles in
-            milliseconds. Off: any number up to ``max_bound``.
+            sentence with no number gets no interval at all. A reference formula
+            whose bounds its sentence never writes is a rare noisy row, and the
+            grammar stays a few rules instead of two per number up to ``max_bound``.
+            Off: any number up to ``max_bound``.
         max_tokens: Budget for unconstrained answers.
     """
 
@@ -62,10 +65,10 @@ class TranslatorConfig:
     max_tokens: int = 96
 
     def __post_init__(self) -> None:
-        if self.max_depth < 1 or self.max_args < 2 or self.max_tokens < 1:
+        if self.max_depth < 1 or self.max_args < 2 or self.max_tokens < 1 or self.max_bound < 0:
             raise ConfigError(
-                f"need max_depth >= 1, max_args >= 2, max_tokens >= 1; got {self.max_depth}, "
-                f"{self.max_args}, {self.max_tokens}"
+                f"need max_depth >= 1, max_args >= 2, max_tokens >= 1, max_bound >= 0; got "
+                f"{self.max_depth}, {self.max_args}, {self.max_tokens}, {self.max_bound}"
             )
 
     def syntax(self, aps: Sequence[str], nl: str | None = None) -> Syntax:

@@ -136,16 +136,20 @@ def test_each_server_gets_the_grammar_in_its_documented_field(flavour, fields):
 @pytest.fixture()
 def deaf_server():
     """A real HTTP server on loopback that answers like a vLLM which ignores unknown
-    fields: 200 and free text, whatever grammar it was sent."""
+    fields: 200 and free text, whatever grammar it was sent; ``.received`` holds each
+    request's path and body."""
     import json
     import threading
     from http.server import BaseHTTPRequestHandler, HTTPServer
 
     class Handler(BaseHTTPRequestHandler):
         def do_POST(self):  # noqa: N802 (the stdlib's name)
-            self.rfile.read(int(self.headers["Content-Length"]))
-            body = json.dumps({"choices": [{"text": " eventually prop_1 holds",
-                                            "finish_reason": "stop"}]}).encode()
+            asked = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
+            received.append((self.path, asked))
+            text = " eventually prop_1 holds"
+            choice = ({"message": {"role": "assistant", "content": text}}
+                      if self.path.endswith("/chat/completions") else {"text": text})
+            body = json.dumps({"choices": [{**choice, "finish_reason": "stop"}]}).encode()
             self.send_response(200)
             self.send_header("Content-Type", "application/json")
             self.end_headers()
@@ -154,18 +158,42 @@ def deaf_server():
         def log_message(self, *args):
             pass
 
+    received: list[tuple[str, dict]] = []
     httpd = HTTPServer(("127.0.0.1", 0), Handler)
+    httpd.received = received
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
-    yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    yield httpd
     httpd.shutdown()
+
+
+def url_of(httpd) -> str:
+    return f"http://127.0.0.1:{httpd.server_address[1]}"
 
 
 def test_a_server_that_ignores_the_grammar_stops_the_run(deaf_server):
     """Tests that free text from a server that dropped the grammar field is an error
     naming the field and what to check, not a silently invalid answer."""
-    translator = Translator(OpenAIBackend(deaf_server, server="vllm"))
+    translator = Translator(OpenAIBackend(url_of(deaf_server), server="vllm"))
     with pytest.raises(BackendError, match="ignored the grammar.*structured_outputs"):
         translator.translate("eventually (prop_1)", ["prop_1"])
+
+
+@pytest.mark.parametrize(("suffix", "path", "name"), [
+    ("", "/v1/completions", "default"),
+    ("#google/gemma-3-12b-it", "/v1/completions", "google/gemma-3-12b-it"),
+    ("#chat:gpt-4", "/v1/chat/completions", "gpt-4"),
+])
+def test_the_url_names_the_served_model_and_the_api(deaf_server, suffix, path, name):
+    """Tests what --model http://...#NAME sends: the model name a vLLM serves, and with
+    chat: the prompt as one user message to a chat model (the paper's GPT-4 baseline)."""
+    from ara.eval.translate.models import make_backend
+
+    backend = make_backend(url_of(deaf_server) + suffix)
+    answer = backend.complete("NL: go\nSTL:", None, 16, STOP)
+    assert answer.text == " eventually prop_1 holds"
+    (asked_path, asked), = deaf_server.received
+    assert asked_path == path and asked["model"] == name
+    assert ("messages" in asked) == ("chat" in path)
 
 
 @pytest.mark.skipif(not os.environ.get("ARA_TEST_SERVER_URL"),

@@ -1,8 +1,9 @@
 """Grammar-constrained token choice with llguidance, shared by the local backends.
 
 Greedy decoding under a grammar needs the best *allowed* token. Computing the full
-allowed-token mask costs ~70 µs on Gemma's 262k vocabulary, and applying it to the
-logits costs more than that in numpy; most steps need neither. Sample-then-check:
+allowed-token mask over Gemma's 262k vocabulary, and applying it to the logits in
+numpy, is the dear part of a step, and most steps need neither
+(bench/constrained_overhead.py measures it). Sample-then-check:
 take the unconstrained argmax, ask the matcher whether it may follow; only when it
 may not, compute the mask and take the argmax over the allowed tokens. The result is
 exactly the masked greedy choice either way.
