@@ -5,7 +5,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ara.coordination.milp import SOLVERS
 from ara.coordination.planner_dp import OBJECTIVES
+from ara.coordination.protocol import PLANNERS
 from ara.coordination.trials import INSTANCES
 from ara.errors import ConfigError
 
@@ -17,7 +19,12 @@ WORDINGS = ("paper", "all")
 
 @dataclass(frozen=True)
 class Exp2Config:
-    """One experiment's settings (recorded in ``run.json``)."""
+    """One experiment's settings (recorded in ``run.json``; ``ara coord exp2 --help``
+    says what each does).
+
+    ``llm`` is ``--model``: ``none`` (helpers plan the template spec) or the model that
+    translates each request; its name is the one earlier run folders recorded.
+    """
 
     trials: int = 100
     seed: int = 3000
@@ -48,8 +55,10 @@ class Exp2Config:
             raise ConfigError(f"--wordings must be one of {WORDINGS}, got {self.wordings!r}")
         if self.wait not in WAITS:
             raise ConfigError(f"--wait must be one of {WAITS}, got {self.wait!r}")
-        if self.planner not in ("dp", "milp"):
-            raise ConfigError(f"--planner must be dp or milp, got {self.planner!r}")
+        if self.planner not in PLANNERS:
+            raise ConfigError(f"--planner must be one of {PLANNERS}, got {self.planner!r}")
+        if self.solver not in SOLVERS:
+            raise ConfigError(f"--solver must be one of {tuple(SOLVERS)}, got {self.solver!r}")
         if self.llm != "none" and self.planner == "dp":
             raise ConfigError("a translated help request can say anything STL can: plan it "
                               "with --planner milp (the DP handles the template spec only)")

@@ -24,7 +24,7 @@ from functools import cached_property
 
 from ara.coordination import routing
 from ara.coordination.milp import LinearModel, MILPSolver, make_solver
-from ara.coordination.planner_dp import Job, leg_lengths
+from ara.coordination.planner_dp import Job, completion_times, leg_lengths
 from ara.coordination.status import Status, checked
 from ara.coordination.world import Cell, GridWorld
 from ara.errors import AraError, ConfigError
@@ -99,13 +99,9 @@ class Schedule:
 def _walk(fleet: Fleet, k: int, route: Sequence[int]) -> tuple[int, int]:
     """Robot k's makespan on ``route``, and when it finishes the help job (0 if not on it)."""
     first, then = fleet.legs
-    t, prev, wait = 0, None, 0
-    for j in route:
-        t += first[k][j] if prev is None else then[prev][j]
-        if j == fleet.help_job:
-            wait = t
-        prev = j
-    return t, wait
+    done = completion_times(route, first[k], then)
+    help_done = done[fleet.help_job] if fleet.help_job in route else 0
+    return (done[route[-1]] if route else 0), help_done
 
 
 def evaluate(fleet: Fleet, routes: Sequence[Sequence[int]], status: str = "heuristic",

@@ -21,6 +21,7 @@ one with the least makespan (both are sums over legs, so the pair orders exactly
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ara.coordination.status import WITH_SOLUTION, Status, checked
@@ -117,7 +118,7 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
         capped = _plan_within_cap(n, from_start, between, start_travel, travel, weight, cap)
         if capped is not None:
             order, cost = capped
-            completion = _completion_times(order, from_start, between)
+            completion = completion_times(order, from_start, between)
             return Plan("optimal", tuple(order), tuple(completion), max(completion), cost)
     inf = float("inf")
     # best[mask][j]: least cost with the jobs of mask done, j last; time[...]: its makespan
@@ -144,7 +145,7 @@ def plan_jobs(world: GridWorld, start: Cell, jobs: list[Job], objective: str = "
                     best[nxt][j], time[nxt][j], parent[nxt][j] = c, time[mask][last] + d, last
     last = min(range(n), key=lambda j: (best[full][j], time[full][j], j))
     order = _unwind(parent, full, last)
-    completion = _completion_times(order, from_start, between)
+    completion = completion_times(order, from_start, between)
     makespan = max(completion)
     if cap is not None and makespan > cap:
         return Plan("over_cap", tuple(order), tuple(completion), makespan, int(best[full][last]))
@@ -232,8 +233,10 @@ def _unwind(parent: list[list[int]], mask: int, last: int) -> list[int]:
     return order[::-1]
 
 
-def _completion_times(order: list[int], from_start: list[int],
-                      between: list[list[int]]) -> list[int]:
+def completion_times(order: Sequence[int], from_start: list[int],
+                     between: list[list[int]]) -> list[int]:
+    """When each job of ``order`` is done, by job index (0 for the jobs not in it), over
+    a robot's legs (:class:`JobLegs`'s ``from_start`` and ``between``)."""
     done = [0] * len(from_start)
     t, prev = 0, None
     for j in order:

@@ -63,12 +63,13 @@ class Trial:
 
 
 def make_trial(index: int, seed: int, robots: int = 6, jobs: int = 12,
-               instances: str = "paper", world: GridWorld = PAPER_WORLD) -> Trial:
-    """Trial ``index``, drawn from ``seed`` as ``instances`` says (see the module doc)."""
+               instances: str = "paper") -> Trial:
+    """Trial ``index`` on the paper's grid, drawn from ``seed`` as ``instances`` says (see
+    the module doc)."""
     if instances not in INSTANCES:
         raise ConfigError(f"instances must be one of {INSTANCES}, got {instances!r}")
     draw = _paper_draw if instances == "paper" else _uniform_draw
-    site, starts, drawn = draw(seed, robots, jobs, world.free_cells)
+    site, starts, drawn = draw(seed, robots, jobs, PAPER_WORLD.free_cells)
     return Trial(index, seed, site, starts, drawn)
 
 

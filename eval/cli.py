@@ -211,9 +211,9 @@ def translate_file_cmd(
 
     from tqdm import tqdm
 
-    from ara.data.normalize import form_of
     from ara.eval.translate.answering import AnswerConfig, worked_examples
     from ara.eval.translate.batch import (
+        check_out,
         done_lines,
         same_settings,
         summarize,
@@ -230,29 +230,16 @@ def translate_file_cmd(
         todo = read_requests(requests, config)
         how = AnswerConfig.of(repair=repair, seed=seed, alternatives=alternatives,
                               budget_s=budget)
-        if out.is_dir():
-            raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
-        if not out.parent.is_dir():
-            raise ConfigError(f"--out {out}: there is no folder {out.parent}")
-        if out.exists() and out.stat().st_size and not resume:
-            raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
-                              "another --out")
+        check_out(out, resume)
         translator = Translator(shared_backend(model, server=server), config)
         same_settings(out, {"model": translator.backend.model_id, "answer": asdict(how),
                             "translator": asdict(config), "shots": shots,
                             "examples_by": examples_by,
                             "examples": None if examples is None else str(examples)})
         done = done_lines(out, todo, translator.backend.model_id)
-        drawn: dict[str, list] = {}
 
-        def shots_for(nl: str, aps: tuple[str, ...]) -> list:
-            if examples_by == "similar":
-                return worked_examples(model, shots, aps, seed, nl, examples_by, examples)
-            # The same examples for every request of a form, as ara translate would pick.
-            form = form_of(aps)
-            if form not in drawn:
-                drawn[form] = worked_examples(model, shots, aps, seed, pool=examples)
-            return drawn[form]
+        def shots_for(nl: str, aps: tuple[str, ...]) -> list:  # as ara translate picks them
+            return worked_examples(model, shots, aps, seed, nl, examples_by, examples)
 
         if done:
             typer.echo(f"resuming {out} after {done} of {len(todo)} answers", err=True)

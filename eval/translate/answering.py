@@ -249,7 +249,7 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int
     """
     from ara.data.normalize import form_of
     from ara.eval.translate.models import default_shots
-    from ara.eval.translate.similar import EXAMPLES_BY, index_for
+    from ara.eval.translate.similar import EXAMPLES_BY
 
     if by not in EXAMPLES_BY:
         raise ConfigError(f"examples by {by!r}? choose one of {', '.join(EXAMPLES_BY)}")
@@ -257,23 +257,31 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int
     if not k:
         return []
     form = form_of(tuple(aps))
-    if pool is None:
-        from ara.data import load_or_prepare  # prepares the split on first use
-
-        records = load_or_prepare("compositional").records("train", form)
-    else:
-        records = [r for r in _pool_file(str(pool)) if r.form == form]
+    records = _pool(form, None if pool is None else str(pool))
     if k > len(records):
         raise ConfigError(f"{k} worked examples asked for (--shots), but the pool has only "
                           f"{len(records)} {form} pairs")
     if by == "similar":
-        return [Shot.of(r) for r in index_for(records).nearest(nl, aps, k)]
-    return sample_shots(records, k, random.Random(seed))
+        return [Shot.of(r) for r in _pool_index(form, None if pool is None else str(pool))
+                .nearest(nl, aps, k)]
+    return sample_shots(list(records), k, random.Random(seed))
 
 
-@lru_cache(maxsize=4)
-def _pool_file(path: str) -> tuple:
-    return tuple(read_pairs(Path(path), TranslatorConfig()))
+# A process that translates many requests reads and indexes a pool once, not per request.
+@lru_cache(maxsize=8)
+def _pool(form: str, path: str | None) -> tuple:
+    if path is None:
+        from ara.data import load_or_prepare  # prepares the split on first use
+
+        return tuple(load_or_prepare("compositional").records("train", form))
+    return tuple(r for r in read_pairs(Path(path), TranslatorConfig()) if r.form == form)
+
+
+@lru_cache(maxsize=8)
+def _pool_index(form: str, path: str | None):
+    from ara.eval.translate.similar import index_for
+
+    return index_for(_pool(form, path))
 
 
 def notes(answer: Answer, nl: str = "") -> list[str]:

@@ -24,6 +24,18 @@ from ara.grammars.spot_bridge import judge
 from ara.provenance import differing
 
 
+def check_out(out: Path, resume: bool) -> None:
+    """Refuse an ``out`` this run cannot write its answers to, before any model loads:
+    a folder, a file in no folder, or another run's answers without ``resume``."""
+    if out.is_dir():
+        raise ConfigError(f"--out {out} is a folder: name the JSON Lines file to write")
+    if not out.parent.is_dir():
+        raise ConfigError(f"--out {out}: there is no folder {out.parent}")
+    if out.exists() and out.stat().st_size and not resume:
+        raise ConfigError(f"{out} exists: pass --resume to go on with it, or choose "
+                          "another --out")
+
+
 def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int:
     """How many of ``requests`` ``out`` already answers, in order, by this model; a
     last line cut off by an interruption is dropped from the file.

@@ -200,3 +200,12 @@ def test_helpers_share_one_translation_of_a_request(llama_backend):
     assert vote.results[0] is shared.translate(nl, aps)  # repair's greedy call, kept
     # the greedy answer alone, or with 2 samples and the greedy answer's mends
     assert len(vote.results) == 1 or len(vote.results) >= 3
+
+
+@pytest.mark.parametrize(("bad", "named"), [({"solver": "cplex"}, "--solver"),
+                                            ({"planner": "astar"}, "--planner"),
+                                            ({"objective": "fastest"}, "--objective")])
+def test_the_config_names_a_choice_it_does_not_know(bad, named):
+    """A config read from Python or a run.json is checked as the command line is."""
+    with pytest.raises(ConfigError, match=f"{named} must be one of"):
+        Exp2Config(**bad)
