@@ -90,10 +90,10 @@ def shared_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     their defaults are one entry): loading the embedded model and an adapter takes
     seconds, a translation a fraction of one. ``ara translate``, ``ara translate-file``,
     ``ara demo`` and :func:`ara.translate` share it, so a process that translates with
-    several settings loads each model once. Sharing changes no answer: a local
-    backend answers a prompt as a fresh one does, whatever it was asked before (see
-    its prefix reuse). A model that fails to load is not kept;
-    ``shared_backend.cache_clear()`` lets the loaded ones go.
+    several settings loads each model once. Sharing changes no answer of the llama.cpp
+    backend, which answers a prompt as a fresh one does whatever it was asked before;
+    the transformers backend's, up to float rounding (docs/evaluation.md). A model that
+    fails to load is not kept; ``shared_backend.cache_clear()`` lets the loaded ones go.
 
     Raises:
         BackendError: As :func:`make_backend`.
