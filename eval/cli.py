@@ -17,6 +17,7 @@ from ara.eval.translate.answering import BUDGET_S
 from ara.eval.translate.backends.openai_http import GRAMMAR_FIELDS
 from ara.eval.translate.confidence import DOUBT
 from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
+from ara.eval.translate.repair import TEMPERATURE as REPAIR_TEMPERATURE
 from ara.eval.translate.similar import EXAMPLES_BY as EXAMPLES_BY_VALUES
 
 # Options with a fixed set of values: the help lists them, and typer refuses others.
@@ -63,7 +64,7 @@ ANY_BOUND = typer.Option(
     False, "--any-bound",
     help="Let bounds be any number up to --max-bound, not only 0 and the sentence's own.")
 # Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
-TEMPERATURE = typer.Option(0.7, "--temperature", help=REPAIR_HELP["temperature"])
+TEMPERATURE = typer.Option(REPAIR_TEMPERATURE, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
                              f"{DEFAULT_REPAIR} (0 where answers are voted); 0: off.")
 REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])

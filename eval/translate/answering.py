@@ -28,6 +28,7 @@ from ara.eval.translate.deadline import Deadline
 from ara.eval.translate.prompt import Shot, sample_shots
 from ara.eval.translate.repair import (
     REPAIR_BY,
+    TEMPERATURE,
     RepairConfig,
     Vote,
     readings,
@@ -95,7 +96,7 @@ class AnswerConfig:
 
     @classmethod
     def of(cls, samples: int = 1, repair: int | None = None, repair_by: str = REPAIR_BY[0],
-           doubt: float = DOUBT, temperature: float = 0.7, seed: int = 0,
+           doubt: float = DOUBT, temperature: float = TEMPERATURE, seed: int = 0,
            **rest) -> AnswerConfig:
         """The config of ``ara translate``'s options, named as the command names them."""
         return cls(samples, RepairConfig(repair, repair_by, doubt, temperature, seed), **rest)

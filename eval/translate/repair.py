@@ -43,6 +43,9 @@ from ara.grammars.spot_bridge import same_meaning
 #: each way of repairing fixed and broke on the held-out sets: docs/what-moved.md.
 DEFAULT_REPAIR = 8
 
+#: The temperature repair and self-consistency draw their answers at.
+TEMPERATURE = 0.7
+
 #: How repair looks for a better answer (see :func:`translate_repaired`).
 REPAIR_BY = ("samples+edits", "edits", "samples")
 
@@ -83,7 +86,7 @@ class RepairConfig:
     samples: int | None = None
     by: str = REPAIR_BY[0]
     doubt: float = DOUBT
-    temperature: float = 0.7
+    temperature: float = TEMPERATURE
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -161,7 +164,7 @@ def readings(vote: Vote, timeout_s: float = 10.0, limit: int | None = None,
 
 def translate_consistent(translator: Translator, nl: str, aps: Sequence[str],
                          shots: Sequence[Shot] = (), samples: int = 5,
-                         temperature: float = 0.7, seed: int = 0,
+                         temperature: float = TEMPERATURE, seed: int = 0,
                          timeout_s: float = 10.0, grammar_in_prompt: bool = False,
                          deadline: Deadline = UNBOUNDED) -> Vote:
     """Translate ``nl`` ``samples`` times under the grammar and keep the majority meaning.
