@@ -35,6 +35,13 @@ from pathlib import Path
 from ara.errors import ConfigError
 from ara.run_store import read_samples
 
+#: Test pairs ``scripts/eval_generalization.sh`` samples from each held-out set per form
+#: (``$LIMIT`` overrides); a hand-written suite, at most :data:`SUITE_LIMIT`, runs whole.
+#: The judge reuses a shipped run only where it was made with these.
+HELD_OUT_LIMITS = {"compositional": 50, "timed": 100, "timed-unseen": 100, "paper": 100,
+                   "disjoint": 100}
+SUITE_LIMIT = 200
+
 HELP_FILES = {"candidate": "help-request-wordings.json",
               "shipped": "help-request-wordings-shipped.json"}
 MODELS = ("shipped", "candidate")

@@ -8,7 +8,8 @@
 # (default: all): each hand-written suite of ara.data.handwritten.SUITES but the blind
 # ones in WAITING (all of its entries; docs/data.md says which were read to guide what),
 # compositional (held-out shapes and phrasings, 50 lifted + 50 grounded), timed (NL2TL's lifted dev file, 100),
-# paper and disjoint (100 lifted each); $LIMIT overrides those sampled sizes (a suite
+# paper and disjoint (100 lifted each; ara.eval.verdict.HELD_OUT_LIMITS holds these sizes);
+# $LIMIT overrides those sampled sizes (a suite
 # always runs whole). Variants: $VARIANTS (default none,C,F+C; C,F+C on paper and
 # disjoint, where a fine-tune's none equals C), 5 shots for F, one rerun, seed 0,
 # Spot's limit 5 s a pair (undecided counts as wrong); $REPAIR (default 0) turns repair on
@@ -34,6 +35,10 @@ print(*(s for s in SUITES if s not in WAITING))")
 sets=${*:-$suites compositional timed paper disjoint}
 variants=${VARIANTS:-none,C,F+C}
 out=runs/generalization/$name
+limit_of() {  # SET: $LIMIT, else the size ara.eval.verdict.HELD_OUT_LIMITS gives it
+  echo "${LIMIT:-$(.venv/bin/python -c "import sys; from ara.eval.verdict import HELD_OUT_LIMITS as L, SUITE_LIMIT
+print(L.get(sys.argv[1], SUITE_LIMIT))" "$1")}"
+}
 
 run() {  # SPLIT FORM LIMIT [VARIANTS]
   .venv/bin/ara eval ablation --split "$1" --form "$2" --limit "$3" --model "$model" \
@@ -50,9 +55,11 @@ for set in $sets; do
     [[ " $all_suites " == *" $set "* ]] || { echo "unknown suite $set ($all_suites)" >&2; exit 2; }
     [[ " $suites " == *" $set "* ]] ||
       echo "note: $set is a blind suite waiting for a change to judge (WAITING); its answers spend it" >&2
-    run "$set" lifted 200; run "$set" grounded 200 ;;
-  compositional) run compositional lifted "${LIMIT:-50}"; run compositional grounded "${LIMIT:-50}" ;;
-  timed) run timed lifted "${LIMIT:-100}" ;;
+    suite_limit=$(LIMIT='' limit_of "$set")  # a suite runs whole, whatever $LIMIT says
+    run "$set" lifted "$suite_limit"; run "$set" grounded "$suite_limit" ;;
+  compositional) run compositional lifted "$(limit_of compositional)"
+    run compositional grounded "$(limit_of compositional)" ;;
+  timed) run timed lifted "$(limit_of timed)" ;;
   timed-unseen)
     mkdir -p runs/data
     .venv/bin/python - <<'PY'
@@ -65,13 +72,13 @@ with open("runs/data/timed-unseen.jsonl", "w") as f:
         if sentence_key(r.nl) not in seen:
             f.write(json.dumps({"nl": r.nl, "aps": list(r.aps), "stl": r.stl}) + "\n")
 PY
-    .venv/bin/ara eval ablation --data runs/data/timed-unseen.jsonl --limit "${LIMIT:-100}" \
+    .venv/bin/ara eval ablation --data runs/data/timed-unseen.jsonl --limit "$(limit_of timed-unseen)" \
       --model "$model" --variants "$variants" --shots "${SHOTS:-5}" \
       --examples-by "${EXAMPLES_BY:-random}" --reruns 1 --seed 0 --spot-timeout 5 --resume \
       --repair "${REPAIR:-0}" --repair-by "${REPAIR_BY:-samples+edits}" --doubt "${DOUBT:-0.5}" \
       --no-progress --out "$out/timed-unseen-lifted" > /dev/null
     echo "done: $name timed-unseen" ;;
-  paper|disjoint) run "$set" lifted "${LIMIT:-100}" "${VARIANTS:-C,F+C}" ;;
+  paper|disjoint) run "$set" lifted "$(limit_of "$set")" "${VARIANTS:-C,F+C}" ;;
   *) echo "unknown set $set ($suites compositional timed timed-unseen paper disjoint)" >&2
      exit 2 ;;
   esac

@@ -66,6 +66,7 @@ import json, shutil, sys
 from pathlib import Path
 from ara.data import registered_version
 from ara.eval.translate.backends.llama_cpp_backend import lora_id
+from ara.eval.verdict import HELD_OUT_LIMITS, SUITE_LIMIT
 shipped, saved, out, dry, *sets = sys.argv[1:]
 lora = lora_id(shipped)
 asked = []
@@ -77,7 +78,8 @@ for split in sets:
     if len(metas) < len(forms) or not all(
             m["model_id"].endswith(lora) and m["data"]["version"] == registered_version(split)
             and m["config"]["variants"] == ["C"] and not m["config"].get("repair")
-            and m["config"]["shots"] == [5] and m["config"]["limit"] == (100 if split == "timed" else 200)
+            and m["config"]["shots"] == [5]
+            and m["config"]["limit"] == HELD_OUT_LIMITS.get(split, SUITE_LIMIT)
             for m in metas):
         asked.append(split)
         continue

@@ -61,6 +61,8 @@ def test_the_shipped_files_committed_answers_are_copied_only_where_they_are_its_
     import json
     import shutil
 
+    from ara.data import registered_version
+
     saved = Path(__file__).parents[1] / "docs" / "results" / "generalization" / "shipped-greedy"
     answers = tmp_path / "answers"
     for form in ("lifted", "grounded"):
@@ -69,6 +71,12 @@ def test_the_shipped_files_committed_answers_are_copied_only_where_they_are_its_
         meta = json.loads((other / "run.json").read_text())
         meta["model_id"] = meta["model_id"].rsplit(":", 1)[0] + ":0123456789abcdef"
         (other / "run.json").write_text(json.dumps(meta))
+        # The compositional test, sampled (50 a form), as if made on today's version.
+        mixed = shutil.copytree(saved / f"compositional-{form}",
+                                answers / f"compositional-{form}")
+        meta = json.loads((mixed / "run.json").read_text())
+        meta["data"]["version"] = registered_version("compositional")
+        (mixed / "run.json").write_text(json.dumps(meta))
     candidate = tmp_path / "lora.gguf"
     candidate.write_bytes(b"")
     done = judge(str(candidate), "handwritten11", DRY_RUN="1", PAPER="0",
@@ -76,6 +84,7 @@ def test_the_shipped_files_committed_answers_are_copied_only_where_they_are_its_
     assert done.returncode == 0, done.stderr
     copied = [line for line in done.stderr.splitlines() if line.startswith("would copy")]
     assert sorted(line.split()[2].rsplit("/", 1)[1] for line in copied) == [
+        "compositional-grounded", "compositional-lifted",
         "handwritten4-grounded", "handwritten4-lifted"]
     shipped = next(line for line in done.stdout.splitlines()
                    if "finetuned" in line and "shipped-greedy handwritten" in line
