@@ -143,7 +143,12 @@ def prepare(split: str = "paper", seed: int = 0, root: Path | None = None) -> Pr
         })
         folder = root / f"{_key(split, manifest['seed'])}-{manifest['version']}"
         if folder.exists():
-            mf.verify(folder)
+            try:
+                mf.verify(folder)
+            except DataVersionError as err:  # preparing is deterministic: write it anew
+                warnings.warn(f"{err}; writing it anew", stacklevel=2)
+                shutil.rmtree(folder)
+                staging.rename(folder)
         else:
             staging.rename(folder)
     finally:

@@ -160,6 +160,10 @@ class SpotTimeoutError(AraError, TimeoutError):
     """A Spot check that did not finish within its time limit."""
 
 
+class SpotWorkerError(AraError, RuntimeError):
+    """The process that runs time-limited Spot checks ended without an answer."""
+
+
 def equivalent(a: Formula, b: Formula, timeout_s: float | None = None) -> bool:
     """Whether ``a`` and ``b`` hold on exactly the same (infinite, discrete-time) traces.
 
@@ -262,7 +266,15 @@ class _Worker:
                     f"{timeout_s:g} s; the check is exponential in the width of windows "
                     "nested under G (give it longer: timeout_s, or --timeout, --spot-timeout)"
                 )
-            self.cache[key] = self.conn.recv()
+            try:
+                self.cache[key] = self.conn.recv()
+            except (EOFError, OSError):  # it died (killed, out of memory): say so, once
+                self.proc.join()
+                _Worker._instance = None
+                raise SpotWorkerError(
+                    f"Spot's worker process ended (exit code {self.proc.exitcode}) while "
+                    f"deciding {op}({_short(a)}, {_short(b)}); the next check starts another"
+                ) from None
         return self.cache[key]
 
 

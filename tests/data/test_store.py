@@ -71,6 +71,20 @@ def test_a_changed_file_is_refused(tmp_path):
         load_split("timed", root=tmp_path)
 
 
+def test_a_torn_file_is_named_and_preparing_writes_it_anew(tmp_path):
+    """Tests a file cut off mid-line (a full disk, a killed copy): loading names it, not
+    a JSON error, and preparing, which is deterministic, writes the version anew."""
+    split = prepare("timed", 0, tmp_path)
+    path = split.folder / "test.jsonl"
+    whole = path.read_text()
+    path.write_text(whole[: len(whole) // 2])
+    with pytest.raises(DataVersionError, match="ara data prepare --split timed"):
+        load_split("timed", root=tmp_path)
+    with pytest.warns(UserWarning, match="writing it anew"):
+        again = prepare("timed", 0, tmp_path)
+    assert again.folder == split.folder and path.read_text() == whole
+
+
 def test_an_edited_manifest_is_refused(tmp_path):
     """Tests that hand-editing the manifest's counts breaks its version hash."""
     split = prepare("timed", 0, tmp_path)

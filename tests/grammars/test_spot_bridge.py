@@ -143,6 +143,21 @@ def test_a_time_limit_turns_a_runaway_check_into_an_error():
     assert equivalent(parse("F(a | F(b))"), parse("F(a) | F(b)"), timeout_s=30) is True
 
 
+def test_a_worker_that_dies_mid_check_is_a_clear_error_then_replaced():
+    """Tests a worker killed from outside (the OOM killer, a user's kill) in the middle
+    of a check: the check says so by name, and the next one gets a new worker."""
+    import threading
+
+    from ara.grammars.spot_bridge import SpotWorkerError, _Worker
+
+    worker = _Worker.get()
+    threading.Timer(1.0, worker.proc.kill).start()
+    with pytest.raises(SpotWorkerError, match="worker process ended"):
+        equivalent(parse("G(a -> F[20,40](G(c)))"),
+                   parse("G(a -> F[20,40](G(c))) & F[0,40](b)"), timeout_s=60)
+    assert equivalent(parse("F(a | F(b))"), parse("F(a) | F(b)"), timeout_s=30) is True
+
+
 @pytest.mark.skipif(sys.platform != "linux", reason="the worker's tie to its parent is Linux's")
 def test_a_check_does_not_outlive_a_killed_run(tmp_path):
     """Tests that killing a run in the middle of a long Spot check (as a user's Ctrl-\\ or
