@@ -39,6 +39,23 @@ def read_config(path: str | Path) -> dict:
     return data
 
 
+def _number(name: str, value, low: float, *, whole: bool = False, below: float | None = None,
+            none: bool = False, strict: bool = False) -> None:
+    """Refuse a setting that is not a number in range, by name: YAML reads ``2e-4`` as
+    text and ``true`` as a number, which would otherwise fail far from the config."""
+    if value is None and none:
+        return
+    kinds = int if whole else (int, float)
+    if (not isinstance(value, kinds) or isinstance(value, bool) or value < low
+            or (strict and value == low) or (below is not None and value >= below)):
+        wanted = f"a {'whole ' if whole else ''}number {'>' if strict else '>='} {low:g}"
+        wanted += f" and < {below:g}" if below is not None else ""
+        wanted += " (or null)" if none else ""
+        hint = (" (YAML reads 2e-4 as text: write 2.0e-4)"
+                if isinstance(value, str) and "e" in value.lower() else "")
+        raise ConfigError(f"{name} must be {wanted}, got {value!r}{hint}")
+
+
 def _build(cls, data: dict | None, where: str):
     data = data or {}
     if not isinstance(data, dict):
@@ -75,8 +92,13 @@ class LoraSettings:
     target_modules: str | list[str] = "all-linear"
 
     def __post_init__(self) -> None:
-        if self.r < 1 or self.alpha < 1 or not 0 <= self.dropout < 1:
-            raise ConfigError(f"lora needs r >= 1, alpha >= 1, 0 <= dropout < 1; got {self}")
+        _number("lora.r", self.r, 1, whole=True)
+        _number("lora.alpha", self.alpha, 1)
+        _number("lora.dropout", self.dropout, 0, below=1)
+        if not (self.target_modules == "all-linear" or isinstance(self.target_modules, list)
+                and self.target_modules and all(isinstance(m, str) for m in self.target_modules)):
+            raise ConfigError("lora.target_modules must be all-linear or a list of module "
+                              f"names, got {self.target_modules!r}")
 
 
 @dataclass(frozen=True)
@@ -100,9 +122,11 @@ class OptimSettings:
     weight_decay: float = 0.0
 
     def __post_init__(self) -> None:
-        if (self.lr <= 0 or self.batch_size < 1 or self.grad_accum < 1 or self.epochs < 1
-                or self.warmup_steps < 0 or self.weight_decay < 0):
-            raise ConfigError(f"optim values out of range: {self}")
+        _number("optim.lr", self.lr, 0, strict=True)
+        for name in ("batch_size", "grad_accum", "epochs"):
+            _number(f"optim.{name}", getattr(self, name), 1, whole=True)
+        _number("optim.warmup_steps", self.warmup_steps, 0, whole=True)
+        _number("optim.weight_decay", self.weight_decay, 0)
 
 
 @dataclass(frozen=True)
@@ -142,8 +166,11 @@ class DataSettings:
     pairs: str | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "forms", tuple(self.forms))
-        object.__setattr__(self, "shots", tuple(self.shots))
+        for name in ("forms", "shots"):
+            value = getattr(self, name)
+            if isinstance(value, (str, int)):  # shots: 5 for [5]
+                raise ConfigError(f"data.{name} must be a list, e.g. [{value}], got {value!r}")
+            object.__setattr__(self, name, tuple(value))
         if not self.shots or any(not isinstance(k, int) or k < 0 for k in self.shots):
             raise ConfigError(f"data.shots must be a list of counts >= 0, got {self.shots}")
         bad = [f for f in self.forms if f not in ("lifted", "grounded")]
@@ -152,8 +179,8 @@ class DataSettings:
         if self.version is not None and not re.fullmatch(r"[0-9a-f]{12}", str(self.version)):
             raise ConfigError(f"data.version must be 12 hex digits (a prepared version, "
                               f"see data/versions.json) or null, got {self.version!r}")
-        if self.limit is not None and self.limit < 1:
-            raise ConfigError(f"data.limit must be >= 1 or null, got {self.limit}")
+        _number("data.limit", self.limit, 1, whole=True, none=True)
+        _number("data.seed", self.seed, 0, whole=True)
         if not isinstance(self.repeat, dict) or any(
                 not isinstance(k, int) or isinstance(k, bool) or k < 1
                 for k in self.repeat.values()):
@@ -185,8 +212,7 @@ class TrainConfig:
         max_steps: Stop after this many optimizer steps (``None``: the epochs decide).
         checkpoint_every: Save a resumable checkpoint every N steps, >= 1.
         keep_checkpoints: How many of the newest checkpoints to keep, >= 1. Each holds
-            the whole model state (about 1 GB for the 270M), so keeping all of them
-            fills a disk over a few runs.
+            the whole model state, so keeping all of them fills a disk over a few runs.
         eval_pairs: Test pairs for the held-out check at the end (0: none).
         precision: What the frozen base model computes in: ``bf16``, ``fp32``, or
             ``auto`` (default): bf16 where the hardware multiplies it natively (a CUDA
@@ -212,11 +238,11 @@ class TrainConfig:
     data: DataSettings = field(default_factory=DataSettings)
 
     def __post_init__(self) -> None:
-        if self.max_steps is not None and self.max_steps < 1:
-            raise ConfigError(f"max_steps must be >= 1 or null, got {self.max_steps}")
-        if self.checkpoint_every < 1 or self.eval_pairs < 0 or self.keep_checkpoints < 1:
-            raise ConfigError("checkpoint_every and keep_checkpoints must be >= 1, "
-                              "eval_pairs >= 0")
+        _number("max_steps", self.max_steps, 1, whole=True, none=True)
+        _number("checkpoint_every", self.checkpoint_every, 1, whole=True)
+        _number("keep_checkpoints", self.keep_checkpoints, 1, whole=True)
+        _number("eval_pairs", self.eval_pairs, 0, whole=True)
+        _number("seed", self.seed, 0, whole=True)
         if self.precision not in PRECISIONS:
             raise ConfigError(f"precision must be one of {', '.join(PRECISIONS)}, "
                               f"got {self.precision!r}")

@@ -48,10 +48,15 @@ def converter_dir() -> Path:
         return folder
     download = cache_root() / "tools" / "sdist"
     download.mkdir(parents=True, exist_ok=True)
-    subprocess.run([sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--no-binary",
-                    ":all:", "-d", str(download), f"llama-cpp-python=={llama_version}"],
-                   check=True)
-    (sdist,) = download.glob(f"llama_cpp_python-{llama_version}.tar.gz")
+    fetch = [sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--no-binary", ":all:",
+             "-d", str(download), f"llama-cpp-python=={llama_version}"]
+    found = list(download.glob(f"llama_cpp_python-{llama_version}.tar.gz"))
+    if not found and subprocess.run(fetch).returncode != 0:
+        raise ExportError(
+            f"could not fetch llama.cpp's converter (the llama-cpp-python {llama_version} "
+            f"sdist) from the package index: run `{' '.join(fetch[2:])}` where the index "
+            "is reachable, or `make setup`, which does it once")
+    (sdist,) = found or download.glob(f"llama_cpp_python-{llama_version}.tar.gz")
     staging = folder.with_name(folder.name + ".partial")
     prefix = f"llama_cpp_python-{llama_version}/vendor/llama.cpp/"
     wanted = ("convert_hf_to_gguf.py", "convert_lora_to_gguf.py", "conversion/", "gguf-py/")

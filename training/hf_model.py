@@ -1,8 +1,8 @@
 """The embedded Gemma 3 270M as a local Hugging Face folder, converted once.
 
-transformers 5 reads the GGUF (dequantized to float32, ``Gemma3ForCausalLM``, 268M
-parameters), but slowly: about a minute for its 262k-token tokenizer alone, and a
-model loaded from GGUF refuses ``save_pretrained``. So the conversion copies its state
+transformers reads the GGUF (dequantized to float32, ``Gemma3ForCausalLM``), but
+slowly (its 262k-token tokenizer most of all), and a model loaded from GGUF refuses
+``save_pretrained``. So the conversion copies its state
 dict into a fresh ``Gemma3ForCausalLM(config)``, saves that with the tokenizer, and
 writes ``ara_model.json`` (source GGUF hash, versions) beside them. Later calls find
 the folder and return at once. Nothing is downloaded. Also the model's tokenizer, read

@@ -69,6 +69,16 @@ class LoRAFinetuneRecipe:
             raise ConfigError(
                 f"init_adapter: {config.init_adapter} holds no adapter_config.json; name the "
                 "adapter/ folder of a finished run (train that run first)")
+        if config.base_model != "default":  # the default is prepared in setup()
+            _check_base_model(config.base_model)
+        if resume and not whole_checkpoints(self.out):  # before minutes of loading
+            if not self.out.joinpath("run.json").is_file():
+                raise ConfigError(f"--resume: {self.out} holds no run (no run.json): drop "
+                                  "--resume to start one")
+            if self.out.joinpath("adapter").is_dir():
+                raise ConfigError(f"--resume: {self.out} is a finished run (adapter/) with no "
+                                  "checkpoint left to go on from: train into another out "
+                                  "folder")
         self.step = 0
 
     # -- setup: each part needs the ones before it ------------------------------------
@@ -305,12 +315,6 @@ class LoRAFinetuneRecipe:
 
     def _load_checkpoint(self) -> None:
         found = whole_checkpoints(self.out)
-        if not found and not self.out.joinpath("run.json").is_file():
-            raise ConfigError(f"--resume: {self.out} holds no run (no run.json): drop --resume "
-                              "to start one")
-        if not found and self.out.joinpath("adapter").is_dir():
-            raise ConfigError(f"--resume: {self.out} is a finished run (adapter/) with no "
-                              "checkpoint left to go on from: train into another out folder")
         if not found:
             # Killed before its first checkpoint: nothing to go on from, so it starts over
             # (its log's steps are taken again).
@@ -401,3 +405,20 @@ def main(config_path: str, max_steps: int | None = None, resume: bool = False) -
     if max_steps is not None:
         config = TrainConfig.from_dict({**config.to_dict(), "max_steps": max_steps})
     return run_training(config, resume)
+
+
+def _check_base_model(model: str) -> None:
+    """Refuse a ``base_model`` that is neither a folder here nor a hub id in the local
+    Hugging Face cache, before anything loads (nothing is downloaded)."""
+    from huggingface_hub import try_to_load_from_cache
+
+    if Path(model).is_dir():
+        return
+    try:
+        cached = isinstance(try_to_load_from_cache(model, "config.json"), str)
+    except ValueError:  # not a hub id at all (a path that does not exist, say)
+        cached = False
+    if not cached:
+        raise ConfigError(f"base_model {model!r} is no folder here, nor a hub id in the local "
+                          "cache: set it to your local copy of the model (nothing is "
+                          "downloaded)")

@@ -1,7 +1,7 @@
 """A weighted average of LoRA adapters, written as one exact LoRA adapter.
 
-Adapters trained from the same start (here: every compositional run grows from v3's
-adapter) can be averaged in weight space, a "model soup" (Wortsman et al., 2022): runs
+Adapters trained from the same start (the recipe's refinements all grow from its first
+stage) can be averaged in weight space, a "model soup" (Wortsman et al., 2022): runs
 that each learned a little of something different often keep both in the average.
 
 LoRA factors cannot be averaged directly (``mean(B) @ mean(A)`` is not
@@ -11,8 +11,8 @@ stack the ``A`` factors and place each weighted ``B`` beside the others,
     sum_i w_i s_i B_i A_i  =  s [w_1 s_1/s B_1 | ... | w_n s_n/s B_n] [A_1; ...; A_n],
 
 with ``s_i = alpha_i / r_i`` each adapter's scaling and ``s`` the result's. The result is
-exact, loads in PEFT and converts to a GGUF LoRA like any adapter (a rank-16 pair
-becomes rank 32, about twice the file).
+exact, loads in PEFT and converts to a GGUF LoRA like any adapter (two rank-16 adapters
+make one of rank 32).
 
 The summed rank costs time at every token (llama.cpp applies a LoRA unmerged), so
 :func:`reduce_rank` brings an adapter back to a smaller rank: each module's update

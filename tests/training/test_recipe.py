@@ -93,13 +93,21 @@ def test_a_run_killed_before_its_first_checkpoint_resumes_from_step_0(tiny_gemma
 
 def test_resume_refuses_a_folder_with_no_run_and_a_finished_run_without_checkpoints(
         tiny_gemma_dir, tmp_path):
+    """Both before the model loads: the recipe refuses them as it is made."""
     config = tiny_config(tiny_gemma_dir, tmp_path / "run", max_steps=1)
     with pytest.raises(ConfigError, match="holds no run \\(no run.json\\): drop --resume"):
-        LoRAFinetuneRecipe(config, resume=True).setup()
+        LoRAFinetuneRecipe(config, resume=True)
     run_training(config)
     shutil.rmtree(tmp_path / "run" / "checkpoints")  # to save space
     with pytest.raises(ConfigError, match="a finished run \\(adapter/\\) with no checkpoint"):
-        LoRAFinetuneRecipe(config, resume=True).setup()
+        LoRAFinetuneRecipe(config, resume=True)
+
+
+def test_a_base_model_that_is_not_here_is_refused_before_anything_loads(tmp_path):
+    """The 12B config names /models/gemma-3-12b-it: on a machine without it, one line."""
+    config = TrainConfig(base_model=str(tmp_path / "gemma-3-12b-it"), out=str(tmp_path / "r"))
+    with pytest.raises(ConfigError, match="is no folder here, nor a hub id in the local cache"):
+        LoRAFinetuneRecipe(config)
 
 
 def test_too_few_records_for_one_optimizer_step_are_refused(tiny_gemma_dir, tmp_path):

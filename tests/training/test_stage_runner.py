@@ -145,7 +145,7 @@ def test_a_stage_is_what_its_files_hold_not_their_names(tmp_path):
     ([{"name": "a", "train": {}}, {"name": "e", "export": "a"}, {"name": "f", "export": "e"}],
      "reads e, an export"),
     ([{"name": "a", "train": {}, "soup": ["a"]}], "exactly one of train, soup, export"),
-    ([{"name": "a", "train": {"optim": {"lr": -1}}}], "optim values out of range"),
+    ([{"name": "a", "train": {"optim": {"lr": -1}}}], "optim.lr must be a number > 0"),
     ([{"name": "a", "train": {"lora": {"rank": 4}}}], "unknown key lora.rank"),
 ])
 def test_a_recipe_that_cannot_run_is_refused_before_anything_trains(stages, message):
