@@ -14,7 +14,8 @@ data_app = typer.Typer(help="Prepare, inspect and export the versioned NL2TL spl
                        no_args_is_help=True)
 
 ROOT_OPT = typer.Option(None, "--root", file_okay=False,
-                        help="Folder of prepared splits [default: data/prepared].")
+                        help="Folder of prepared splits [default: $ARA_DATA_DIR, else "
+                             "data/prepared].")
 
 
 @data_app.command("prepare")

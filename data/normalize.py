@@ -6,6 +6,7 @@ dropped silently. See ``raw/nl2tl/SOURCE.md`` for the raw fields.
 
 from __future__ import annotations
 
+import errno
 import gzip
 import hashlib
 import json
@@ -94,11 +95,6 @@ class _RowError(AraError, ValueError):
     pass
 
 
-def read_jsonl(path: Path) -> list[dict]:
-    """The rows of a raw JSON-lines file (blank lines skipped)."""
-    return _rows(path.read_text())
-
-
 def read_raw(raw_dir: Path, name: str) -> tuple[list[dict], str]:
     """The rows of the vendored file ``name`` and the sha256 of its text.
 
@@ -108,7 +104,7 @@ def read_raw(raw_dir: Path, name: str) -> tuple[list[dict], str]:
     """
     path = raw_dir / f"{name}.gz"
     if not path.is_file():
-        raise FileNotFoundError(f"no vendored file {path}")
+        raise FileNotFoundError(errno.ENOENT, "no vendored raw file", str(path))
     data = gzip.decompress(path.read_bytes())
     return _rows(data.decode()), hashlib.sha256(data).hexdigest()
 

@@ -64,13 +64,13 @@ from ara.grammars.ast import (
 )
 from ara.grammars.english import UNITS, Realizer, held_for, realize
 from ara.grammars.printer import to_text
-from ara.grammars.syntax import Syntax
+from ara.grammars.syntax import DECODING_MAX_ARGS, DECODING_MAX_DEPTH, Syntax
 
 SYNTHETIC_VERSION = "4.0.0"
 #: Deepest pattern-built formula: the decoding grammar's depth (the translator's
 #: ``max_depth``), so that a three-step sequence ``F(a & F(b & F(c)))`` (depth 5) is
 #: drawn; :attr:`SynthSettings.max_depth` bounds the random growth.
-PATTERN_MAX_DEPTH = 5
+PATTERN_MAX_DEPTH = DECODING_MAX_DEPTH
 SOURCE = "synthetic"
 
 
@@ -471,7 +471,8 @@ def synthetic_records(rows: int, seed: int, held_out: bool,
     s = settings or SynthSettings()
     rng = random.Random(f"{seed}:{'test' if held_out else 'train'}:{SYNTHETIC_VERSION}")
     mode = "test" if held_out else "train"
-    syntax = Syntax(aps=None, intervals=True, max_bound=s.max_bound, max_depth=5, max_args=2)
+    syntax = Syntax(aps=None, intervals=True, max_bound=s.max_bound,
+                    max_depth=DECODING_MAX_DEPTH, max_args=DECODING_MAX_ARGS)
     uid, records, seen = UidMaker(), [], set()
     while len(records) < 2 * rows:
         drawn = pair(rng, s, mode, held_out)

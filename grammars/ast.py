@@ -153,7 +153,8 @@ class Until:
 
 Formula = Atom | Const | Not | And | Or | Implies | Iff | Eventually | Always | Next | Until
 BINARY = (And, Or, Implies, Iff, Until)
-TEMPORAL_UNARY = (Eventually, Always, Next)
+#: The temporal operators: a formula without any speaks of one instant.
+TEMPORAL = (Eventually, Always, Next, Until)
 
 
 def _check_nary(kind: str, args: object) -> None:
@@ -206,9 +207,14 @@ def atoms_read_now(node: Formula) -> frozenset[str]:
     temporal operator (``a`` in ``a -> F(b)``, none in ``G(a)``)."""
     if isinstance(node, Atom):
         return frozenset({node.name})
-    if isinstance(node, (Eventually, Always, Until, Next)):
+    if isinstance(node, TEMPORAL):
         return frozenset()
     return frozenset().union(*(atoms_read_now(c) for c in children(node)))
+
+
+def is_temporal(formula: Formula) -> bool:
+    """Whether ``formula`` has a temporal operator anywhere."""
+    return any(isinstance(node, TEMPORAL) for node in walk(formula))
 
 
 def signed_atoms(node: Formula, negated: bool = False) -> frozenset[tuple[str, bool]]:

@@ -47,6 +47,7 @@ from ara.grammars.ast import (
     Or,
     Until,
     conjuncts,
+    is_temporal,
     walk,
 )
 
@@ -385,6 +386,7 @@ class Realizer:
 def explain(formula: Formula) -> str:
     """A deterministic plain-English reading of ``formula``.
 
+    >>> from ara.grammars import parse
     >>> explain(parse("G(a -> F[0,5](b))"))
     'whenever a, b within 5 steps'
     """
@@ -465,7 +467,7 @@ def _say(f: Formula, r: Realizer, used: list[str] | None, embedded: bool,
                           b=sub(f.rhs))
         return _timed("U", f.interval, r, used, allow=allow, a=sub(f.lhs), b=sub(f.rhs))
     op = "->" if isinstance(f, Implies) else "<->"
-    if op == "->" and r.in_words and now and _timeless(f.lhs):
+    if op == "->" and r.in_words and now and not is_temporal(f.lhs):
         op = "->now"  # "if the door is open, ..." would read as a standing rule
     if embedded:
         return r.pick(op + "()", used, a=sub_now(f.lhs), b=sub_now(f.rhs))
@@ -535,11 +537,6 @@ def _said_first(operand: Formula) -> Callable[[str], bool] | None:
     return lambda p: not p.startswith("{a}")
 
 
-def _timeless(f: Formula) -> bool:
-    """Whether ``f`` has no temporal operator (it speaks of one instant)."""
-    return not any(isinstance(g, (Eventually, Always, Until, Next)) for g in walk(f))
-
-
 def _untimed(f: Formula, op: type) -> Formula | None:
     """The argument of an untimed ``op`` (``Eventually``, ``Always``), else ``None``."""
     return f.arg if isinstance(f, op) and f.interval is None else None
@@ -564,7 +561,7 @@ def _idiom(f: Formula, r: Realizer, used: list[str] | None, now: bool = False) -
         return r.pick("GF_n", used, a=sub(gap.arg), n=gap.interval.hi)
     if isinstance(f, Eventually) and f.interval is not None and f.interval.hi is not None \
             and _untimed(f.arg, Always) is not None \
-            and (_timeless(f.arg.arg) or isinstance(f.arg.arg, Until)):
+            and (not is_temporal(f.arg.arg) or isinstance(f.arg.arg, Until)):
         # "within 5 steps, the gate is closed for good"; over an until too, since
         # "within 31 hours, globally a until b" has no word that lasts
         kept = f.arg.arg

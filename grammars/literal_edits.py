@@ -36,11 +36,12 @@ from ara.grammars.ast import (
     atoms,
     children,
     conjuncts,
+    is_temporal,
     map_children,
     walk,
     with_children,
 )
-from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS, is_temporal
+from ara.grammars.nesting import AGAIN_AND_AGAIN, HAPPENS, HOLDS
 from ara.grammars.printer import to_text
 
 Rebuild = Callable[[Formula], Formula]

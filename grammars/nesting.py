@@ -4,10 +4,10 @@ formulas order steps in time.
 ``F`` and ``G`` nested one in the other say something that needs words of its own:
 ``G(F(a))`` "a again and again", ``F(G(a))`` "a from some point on, for good",
 ``G[0,45](F(a))`` "at every step of the first 45, a at some point later", which is no
-more than ``F[45,inf)(a)`` and is what a slip gives for "keep a on for 45 minutes". The same
+more than ``F[45,inf](a)`` and is what a slip gives for "keep a on for 45 minutes". The same
 operator nested in itself, with one of the two unbounded, says no more than one of
 them would (``F(F(a))`` is ``F(a)``, ``G(G(a))`` is ``G(a)``) or makes a bound void
-(``F[10,25](F(a))`` is ``F[10,inf)(a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
+(``F[10,25](F(a))`` is ``F[10,inf](a)``, ``G(G[0,5](a))`` is ``G(a)``): a sentence
 asks for such a formula only by accident, so a translation that writes one has most
 likely slipped (docs/model-card.md, "How repair and the confidence note work").
 
@@ -33,10 +33,10 @@ from ara.grammars.ast import (
     Formula,
     Iff,
     Implies,
-    Next,
     Not,
     Until,
     children,
+    is_temporal,
     walk,
 )
 
@@ -99,11 +99,6 @@ def orders_in_time(formula: Formula) -> bool:
         if isinstance(node, Implies) and is_temporal(node.rhs):
             return True
     return False
-
-
-def is_temporal(formula: Formula) -> bool:
-    """Whether ``formula`` has a temporal operator anywhere."""
-    return any(isinstance(node, (Eventually, Always, Next, Until)) for node in walk(formula))
 
 
 def temporal_claims(formula: Formula) -> frozenset[str]:

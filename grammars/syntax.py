@@ -31,6 +31,11 @@ from ara.grammars.printer import to_text
 
 #: Bumped whenever the grammar a given Syntax produces changes.
 GRAMMAR_VERSION = "1.0.0"
+#: The language the translator decodes in by default and the synthetic generator writes
+#: in: nesting depth and arguments of one & or |. NL2TL needs depth 4 and two arguments
+#: (``(a & b) & c`` nests), and two keep the longest answer, hence the token budget, short.
+DECODING_MAX_DEPTH = 5
+DECODING_MAX_ARGS = 2
 
 
 @dataclass(frozen=True)

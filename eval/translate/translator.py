@@ -33,6 +33,7 @@ from ara.grammars import (
     require_literals,
     to_text,
 )
+from ara.grammars.syntax import DECODING_MAX_ARGS, DECODING_MAX_DEPTH
 
 
 @dataclass(frozen=True)
@@ -40,10 +41,10 @@ class TranslatorConfig:
     """How requests become grammars and prompts.
 
     Args:
-        max_depth: Nesting depth the constrained grammar allows (NL2TL needs <= 4).
-        max_args: Arguments of one & or | the constrained grammar allows. NL2TL needs 2,
-            and 2 loses nothing (``(a & b) & c`` nests) while keeping the longest
-            string, hence the worst-case token budget, short.
+        max_depth: Nesting depth the constrained grammar allows (default
+            :data:`~ara.grammars.syntax.DECODING_MAX_DEPTH`, the training data's).
+        max_args: Arguments of one & or | the constrained grammar allows (default
+            :data:`~ara.grammars.syntax.DECODING_MAX_ARGS`, which loses nothing).
         intervals: Whether formulas may carry time intervals. On by default: a user
             should not have to know whether a sentence has a time bound, and an
             untimed sentence still comes out untimed.
@@ -57,8 +58,8 @@ class TranslatorConfig:
         max_tokens: Budget for unconstrained answers.
     """
 
-    max_depth: int = 5
-    max_args: int = 2
+    max_depth: int = DECODING_MAX_DEPTH
+    max_args: int = DECODING_MAX_ARGS
     intervals: bool = True
     max_bound: int = 1000
     bounds_from_request: bool = True
