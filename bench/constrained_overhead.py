@@ -49,7 +49,7 @@ def main() -> None:
     args = ap.parse_args()
 
     from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
-    from ara.eval.translate.llama_check import default_model_path
+    from ara.eval.translate.models import default_model_path
 
     split = load_split("paper")
     rng = random.Random(0)

@@ -30,7 +30,7 @@ from ara.eval.translate.translator import Translator
 
 
 def start_loopback_server() -> tuple[str, subprocess.Popen]:
-    from ara.eval.translate.llama_check import default_model_path
+    from ara.eval.translate.models import default_model_path
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

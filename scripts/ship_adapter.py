@@ -105,8 +105,7 @@ def judged(adapter: Path, target: Path, given: Path | None, despite: str | None)
 def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 20,
          judge: dict | None = None) -> dict:
     from ara.data import load_or_prepare
-    from ara.eval.translate.llama_check import default_model_path
-    from ara.eval.translate.models import SHIPPED
+    from ara.eval.translate.models import SHIPPED, default_model_path
     from ara.provenance import sha256_file
     from ara.training.export import parity
 

