@@ -2,40 +2,33 @@
 
     .venv/bin/python scripts/step_seconds_by_shots.py runs/train/gemma3-270m-lora
 
-Reads ``train_log.jsonl``; for logs written before steps recorded their ``shots``, the
-count is drawn again exactly as the recipe drew it (it depends only on seed, epoch and
-batch).
+Reads the run's ``train_log.jsonl`` (every session of it); a step of ``grad_accum``
+micro-batches counts under the worked examples of each.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 from collections import defaultdict
 from pathlib import Path
 
-from ara.training.config import TrainConfig
-from ara.training.dataset import shot_rng
+from ara.training.run_folder import log_rows
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("run", type=Path)
+    parser.add_argument("run", type=Path, help="A training run's folder.")
     run = parser.parse_args().run
-    config = TrainConfig.from_dict(json.loads((run / "run.json").read_text())["config"])
-    log = [json.loads(line) for line in (run / "train_log.jsonl").read_text().splitlines()]
-    per_epoch = json.loads((run / "run.json").read_text())["data"]["train_examples"]
-    per_epoch = -(-per_epoch // config.optim.batch_size)
     seconds = defaultdict(list)
-    for entry in log:
-        if "seconds" not in entry:
+    for entry in log_rows(run / "train_log.jsonl"):
+        if "seconds" not in entry or entry.get("shots") is None:
             continue
-        epoch, index = divmod(entry["step"] - 1, per_epoch)
-        shots = entry.get("shots")
-        if shots is None:
-            shots = shot_rng(config.seed, epoch, index).choice(list(config.data.shots))
-        seconds[shots].append(entry["seconds"])
+        shots = entry["shots"]
+        for k in shots if isinstance(shots, list) else [shots]:
+            seconds[k].append(entry["seconds"])
+    if not seconds:
+        raise SystemExit(f"error: {run / 'train_log.jsonl'} logs no timed step with its shots")
     print("| shots | steps | median s/step |\n|---:|---:|---:|")
     for k in sorted(seconds):
         print(f"| {k} | {len(seconds[k])} | {statistics.median(seconds[k]):.2f} |")
