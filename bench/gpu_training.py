@@ -29,7 +29,6 @@ import time
 from pathlib import Path
 
 import torch
-import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -73,11 +72,12 @@ def random_model(arch: str, tokenizer_dir: Path, folder: Path) -> Path:
 
 def run(arch: str, steps: int, tokenizer_dir: Path, scratch: Path) -> dict:
     from ara.data.store import prepare
-    from ara.training.config import TrainConfig
+    from ara.training.config import TrainConfig, read_config
     from ara.training.recipe import LoRAFinetuneRecipe
+    from ara.training.run_folder import log_rows
     from ara.training.stages import StagedRecipe, is_staged
 
-    shipped = yaml.safe_load((REPO / "training" / "configs" / CONFIGS[arch]).read_text())
+    shipped = read_config(REPO / "training" / "configs" / CONFIGS[arch])
     if is_staged(shipped):  # a recipe: its first stage's run
         recipe = StagedRecipe.from_dict(shipped)
         shipped = recipe.train_config(recipe.stages[0]).to_dict()
@@ -92,8 +92,7 @@ def run(arch: str, steps: int, tokenizer_dir: Path, scratch: Path) -> dict:
     recipe.setup()
     losses = recipe.train()
     wall = time.perf_counter() - start
-    log = [json.loads(line) for line in
-           (scratch / f"{arch}-run" / "train_log.jsonl").read_text().splitlines()]
+    log = log_rows(scratch / f"{arch}-run" / "train_log.jsonl")
     seconds = [row["seconds"] for row in log[3:]] or [row["seconds"] for row in log]
     return {"arch": arch, "config": CONFIGS[arch], "steps": len(log),
             "batch": shipped["optim"]["batch_size"],

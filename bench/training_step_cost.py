@@ -25,18 +25,18 @@ import time
 from pathlib import Path
 
 import torch
-import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 RECIPE = REPO / "training" / "configs" / "gemma3_270m_nl2tl.yaml"
 
 
 def run(name: str, change: dict, steps: int, out: Path) -> dict:
-    from ara.training.config import TrainConfig
+    from ara.training.config import TrainConfig, read_config
     from ara.training.recipe import LoRAFinetuneRecipe
+    from ara.training.run_folder import log_rows
     from ara.training.stages import StagedRecipe
 
-    recipe = StagedRecipe.from_dict(yaml.safe_load(RECIPE.read_text()))
+    recipe = StagedRecipe.from_dict(read_config(RECIPE))
     settings = recipe.train_config(recipe.stages[0]).to_dict()
     for key, value in change.items():
         section, _, field = key.rpartition(".")
@@ -50,7 +50,7 @@ def run(name: str, change: dict, steps: int, out: Path) -> dict:
     training.setup()
     losses = training.train()
     wall = time.perf_counter() - start
-    log = [json.loads(line) for line in (folder / "train_log.jsonl").read_text().splitlines()]
+    log = log_rows(folder / "train_log.jsonl")
     timed = log[2:] or log
     return {"run": name, "lora_dropout": settings["lora"]["dropout"],
             "dtype": str(training.dtype).removeprefix("torch."), "steps": len(log),
