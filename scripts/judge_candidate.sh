@@ -31,7 +31,7 @@ waiting=$($py -c "from ara.data.handwritten import WAITING; print(*WAITING)")
     exit 2; }
 others=$($py -c "from ara.data.handwritten import SUITES, WAITING
 print(*(s for s in SUITES if s not in WAITING and s != 'handwritten'))")
-shipped=$($py -c "from ara.eval.translate.models import SHIPPED; print(SHIPPED)")/gemma3-270m-nl2tl-lora.gguf
+shipped=$($py -c "from ara.eval.translate.models import FINETUNED_LORA; print(FINETUNED_LORA)")
 version=$($py -c "from ara.data import registered_version; print(registered_version('compositional'))")
 root=judge-$(sha256sum "$candidate" | cut -c1-8)-$(sha256sum "$shipped" | cut -c1-8)-$version
 model=lora:$candidate

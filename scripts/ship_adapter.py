@@ -28,6 +28,7 @@ import sys
 from pathlib import Path
 
 from ara.errors import ConfigError
+from ara.eval.translate.models import FINETUNED_LORA, peft_folder
 
 #: What a PEFT adapter folder needs, of what a run's ``adapter/`` holds.
 PEFT_FILES = ("adapter_config.json", "adapter_model.safetensors")
@@ -62,7 +63,7 @@ def recipe_record(export: Path) -> dict | None:
 
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_NAME = "gemma3-270m-nl2tl-lora.gguf"
+DEFAULT_NAME = FINETUNED_LORA.name
 
 
 def judged(adapter: Path, target: Path, given: Path | None, despite: str | None) -> dict:
@@ -122,7 +123,7 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
     shutil.copyfile(export / "lora.gguf", target)
     # The same weights as PEFT, which a warm start from the shipped file reads
     # (`init_adapter: finetuned`): the two must never come from different runs.
-    peft = SHIPPED / f"{target.stem}-peft"
+    peft = peft_folder(target)
     peft.mkdir(exist_ok=True)
     for part in PEFT_FILES:
         shutil.copyfile(run / "adapter" / part, peft / part)

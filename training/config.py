@@ -14,7 +14,7 @@ from pathlib import Path
 import yaml
 
 from ara.errors import ConfigError, refuse_unknown_keys
-from ara.eval.translate.models import SHIPPED
+from ara.eval.translate.models import FINETUNED_LORA, peft_folder
 
 
 def read_config(path: str | Path) -> dict:
@@ -66,7 +66,7 @@ def _build(cls, data: dict | None, where: str):
 
 #: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
 #: by ``--model`` name, beside their GGUF.
-SHIPPED_PEFT = {"finetuned": SHIPPED / "gemma3-270m-nl2tl-lora-peft"}
+SHIPPED_PEFT = {"finetuned": peft_folder(FINETUNED_LORA)}
 #: ``precision`` values (``auto`` picks by machine: :func:`hf_model.training_dtype`).
 PRECISIONS = ("auto", "bf16", "fp32")
 #: Run settings that leave the adapter as it is: how often a run checkpoints, how many
