@@ -27,7 +27,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from ara.errors import ConfigError
+from ara.errors import AraError, ConfigError
 from ara.eval.translate.models import FINETUNED_LORA, peft_folder
 
 #: What a PEFT adapter folder needs, of what a run's ``adapter/`` holds.
@@ -168,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
             judge = judged(export_folders(args.export)[1] / "lora.gguf", target, args.verdict,
                            args.despite)
         manifest = ship(args.export, args.name, args.split, args.min_agreement, judge=judge)
-    except ConfigError as error:
+    except (AraError, FileNotFoundError, PermissionError) as error:  # what a user can fix
         print(f"error: {error}", file=sys.stderr)
         return 2
     print(json.dumps({k: manifest[k] for k in ("file", "sha256")}
