@@ -34,7 +34,8 @@ eval_app = typer.Typer(
 
 MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (with "
               "the paper split's), default (without), "
-              "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint")
+              "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint "
+              "(#NAME after it: the model name sent; #chat:NAME: a chat model)")
 SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
                "llama, vllm, sglang, or openai (none: constrained decoding is refused, so "
                "ara translate needs one of the other three).")
