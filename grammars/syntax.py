@@ -88,10 +88,16 @@ class Syntax:
                 raise ConfigError(f"bounds must be a non-empty set of integers in "
                                   f"0..max_bound={self.max_bound}, got {self.bounds!r}")
             object.__setattr__(self, "bounds", bounds)
-        if self.max_depth is not None and self.max_depth < 1:
-            raise ConfigError(f"max_depth must be >= 1 or None, got {self.max_depth!r}")
-        if self.max_args is not None and self.max_args < 2:
-            raise ConfigError(f"max_args must be >= 2 or None, got {self.max_args!r}")
+        if not self.intervals and (self.allow_inf or self.bounds is not None):
+            # Else they would be dropped silently, and the grammar cached and recorded
+            # under settings that do not shape it.
+            raise ConfigError("allow_inf and bounds shape intervals: set intervals=True")
+        for name, low in (("max_depth", 1), ("max_args", 2)):
+            value = getattr(self, name)
+            if value is not None and (not isinstance(value, int) or isinstance(value, bool)
+                                      or value < low):
+                raise ConfigError(f"{name} must be a whole number >= {low} or None, "
+                                  f"got {value!r}")
         if self.relaxed and (self.max_depth is not None or self.max_args is not None):
             raise ConfigError(
                 "max_depth and max_args bound the canonical layout only; "

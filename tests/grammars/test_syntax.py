@@ -65,8 +65,12 @@ def test_rejections_say_which_rule(syntax, text, message):
         (dict(aps=("F",)), "not a valid name"),  # keywords cannot be propositions
         (dict(aps=("go-to",)), "not a valid name"),
         (dict(max_bound=-1), "max_bound must be an integer >= 0"),
-        (dict(max_depth=0), "max_depth must be >= 1"),
-        (dict(max_args=1), "max_args must be >= 2"),
+        (dict(max_depth=0), "max_depth must be a whole number >= 1"),
+        (dict(max_depth=2.5), "max_depth must be a whole number >= 1"),
+        (dict(max_args=1), "max_args must be a whole number >= 2"),
+        # What shapes intervals shapes nothing without them (ara grammar refuses it too).
+        (dict(allow_inf=True), "set intervals=True"),
+        (dict(bounds=(0, 5)), "set intervals=True"),
         (dict(relaxed=True, max_depth=3), "canonical layout only"),
     ],
 )
