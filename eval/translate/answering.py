@@ -257,14 +257,13 @@ def worked_examples(model: str, shots: int | None, aps: Sequence[str], seed: int
     k = shots if shots is not None else default_shots(model)
     if not k:
         return []
-    form = form_of(tuple(aps))
-    records = _pool(form, None if pool is None else str(pool))
+    form, source = form_of(tuple(aps)), None if pool is None else str(pool)
+    records = _pool(form, source)
     if k > len(records):
         raise ConfigError(f"{k} worked examples asked for (--shots), but the pool has only "
                           f"{len(records)} {form} pairs")
     if by == "similar":
-        return [Shot.of(r) for r in _pool_index(form, None if pool is None else str(pool))
-                .nearest(nl, aps, k)]
+        return [Shot.of(r) for r in _pool_index(form, source).nearest(nl, aps, k)]
     return sample_shots(list(records), k, random.Random(seed))
 
 
