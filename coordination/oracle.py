@@ -19,7 +19,7 @@ import math
 import random
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 from ara.coordination import routing
@@ -90,7 +90,6 @@ class Schedule:
     feasible: bool  # a schedule, every makespan within the cap
     status: Status = "heuristic"
     solve_s: float = 0.0
-    extra: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         checked(self.status)
@@ -311,12 +310,10 @@ def exact(fleet: Fleet, solver: MILPSolver | None = None, pinned: dict[int, int]
     solution = routing.solve(m, solver, time_limit_s)
     if not solution.has_solution:
         return Schedule((), (), 0, 0, False, solution.status, solution.solve_s)
-    size = m.size  # the model's own, without the canonical solve's bound row
     if canonical and solution.status == "optimal":
         solution = _canonical(m, solution, solver, time_limit_s)
     routes = [[int(j) for j in route] for route in routing.routes(problem, solution.values)]
-    return replace(evaluate(fleet, routes, solution.status, solution.solve_s),
-                   extra={"gap": solution.gap, **size})
+    return evaluate(fleet, routes, solution.status, solution.solve_s)
 
 
 def _routing_problem(fleet: Fleet, pinned: dict[int, int], horizon: int):
