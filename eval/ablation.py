@@ -52,7 +52,7 @@ def run_ablation(config: AblationConfig, backend: Backend, out: Path, resume: bo
     """
     if concurrency < 1:
         raise ConfigError(f"--concurrency must be >= 1, got {concurrency}")
-    if concurrency > 1 and not getattr(backend, "concurrent", False):
+    if concurrency > 1 and not backend.concurrent:
         raise ConfigError("--concurrency > 1 needs a remote backend (--model http://...): a "
                           "local model generates one answer at a time")
     split = load_data(config) if split is None else split

@@ -219,7 +219,7 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     Returns:
         A :class:`Vote` of one answer when the greedy one leaves nothing out (and is
         not doubted), ``samples`` is 0, or the backend can neither score nor sample (an
-        HTTP server); otherwise of all answers considered, greedy first. With a gap,
+        HTTP server); a backend that cannot sample draws none. Otherwise of all answers considered, greedy first. With a gap,
         the greedy answer wins unless another leaves out less. Ranked by score, answers
         of the same text share a group, best score first; a mended answer's result is
         the greedy one's with the formula replaced (timings and token counts are the
@@ -233,7 +233,7 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     # Without intervals no answer can write a bound: only the other gaps count.
     bounds = translator.config.intervals
     gap = _missing(request, greedy.stl, bounds)
-    helpless = not translator.can_score and not getattr(translator.backend, "can_sample", True)
+    helpless = not translator.can_score and not translator.backend.can_sample
     if not samples or gap == float("inf") or helpless:
         return Vote((greedy,), ((0,),), (time.perf_counter() - start) * 1e3)
     if not gap:
@@ -362,6 +362,8 @@ def literal_mends(translator: Translator, request: Request, stl: str,
 def _draw(translator: Translator, nl: str, aps: Sequence[str], shots: Sequence[Shot],
           n: int, temperature: float, seed: int,
           grammar_in_prompt: bool, deadline: Deadline) -> list[TranslationResult]:
+    if not translator.backend.can_sample:
+        return []
     return [translator.translate(nl, aps, shots, grammar_in_prompt,
                                  sampling=Sampling(temperature=temperature, seed=seed + i))
             for i in range(1, n + 1) if not deadline.spent()]

@@ -47,6 +47,21 @@ def test_outlines_and_llguidance_paths_agree(hf_backend, hf_model_dir, paper_spl
         assert a.valid and a.stl == b.stl
 
 
+@pytest.mark.slow  # outlines' CFG path takes over a minute for two answers on 2 cores
+def test_repair_on_a_backend_that_cannot_sample_ranks_what_it_has(hf_model_dir, paper_split):
+    """Tests that outlines' greedy-only masks make repair draw nothing, not fail: every
+    greedy answer is doubted here (doubt 1), which would draw 8 samples."""
+    from ara.eval.translate.backends.hf_backend import HFBackend
+    from ara.eval.translate.repair import RepairConfig, translate_repaired
+
+    translator = Translator(HFBackend(hf_model_dir, mask="outlines"))
+    assert not translator.backend.can_sample and translator.can_score
+    record = paper_split.records("test", "lifted")[0]
+    vote = translate_repaired(translator, record.nl, record.aps,
+                              repair=RepairConfig(8, doubt=1.0))
+    assert vote.answers and all(a is not None for a in vote.answers)
+
+
 def test_unknown_model_is_a_clear_error(tmp_path):
     """Tests the message for a folder that holds no model (nothing is downloaded)."""
     from ara.eval.translate.backends.hf_backend import HFBackend

@@ -76,6 +76,11 @@ class Backend(Protocol):
 
     #: Identifies the model in outputs (file hash, hub id or endpoint and model name).
     model_id: str
+    #: ``complete`` takes a :class:`Sampling` (repair draws answers); else it keeps the
+    #: greedy one.
+    can_sample: bool
+    #: ``complete`` may be called from several threads at once (``--concurrency``).
+    concurrent: bool
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
                  stop: str, sampling: Sampling | None = None) -> Completion:

@@ -38,6 +38,9 @@ class HFBackend:
         dtype: torch dtype name for the weights (default float32 on CPU, bfloat16 on GPU).
     """
 
+    #: One model decodes one prompt at a time (batched decoding is not written).
+    concurrent = False
+
     def __init__(self, model: str, mask: str = "llguidance", device: str | None = None,
                  dtype: str | None = None) -> None:
         import torch
@@ -46,6 +49,7 @@ class HFBackend:
         if mask not in MASK_ENGINES:
             raise BackendError(f"unknown mask engine {mask!r}; choose one of {MASK_ENGINES}")
         self._torch = torch
+        self.can_sample = mask == "llguidance"  # outlines' masks are for greedy decoding
         self.device = device or ("cuda" if torch.cuda.is_available() else "cpu")
         dtype = dtype or ("float32" if self.device == "cpu" else "bfloat16")
         try:

@@ -66,6 +66,10 @@ class LlamaCppBackend:
         BackendError: If the model file is missing or llama.cpp cannot load it.
     """
 
+    can_sample = True
+    #: One llama.cpp context decodes one sequence at a time.
+    concurrent = False
+
     def __init__(self, model_path: str, n_ctx: int = 4096, n_threads: int | None = None,
                  mask: str = "llguidance", lora_path: str | None = None) -> None:
         import llama_cpp

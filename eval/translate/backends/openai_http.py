@@ -55,7 +55,6 @@ class OpenAIBackend:
 
     #: Requests may be in flight at once (``--concurrency``): the server batches them.
     concurrent = True
-
     def __init__(self, base_url: str, model: str = "default", api: str = "completions",
                  timeout_s: float = 120.0, server: str = "openai") -> None:
         if api not in ("completions", "chat"):
