@@ -15,7 +15,7 @@ from ara.eval.translate.request_file import read_pairs
 from ara.eval.translate.translator import TranslatorConfig
 from ara.eval.user_data import file_split
 
-from conftest import needs_llama
+from conftest import needs_llama, run_ara
 
 ARA = str(Path(sys.executable).with_name("ara"))
 
@@ -139,11 +139,10 @@ def test_plan_draws_examples_from_the_users_file_or_the_compositional_side(tmp_p
 def test_cli_refuses_a_split_and_a_file_together(tmp_path):
     """Tests the messages for --split with --data, and --examples without --data."""
     data = write(tmp_path / "mine.jsonl", PAIRS)
-    both = subprocess.run([ARA, "eval", "ablation", "--split", "paper", "--data", str(data),
-                           "--out", str(tmp_path / "a")], capture_output=True, text=True)
+    both = run_ara("eval", "ablation", "--split", "paper", "--data", str(data),
+                   "--out", str(tmp_path / "a"))
     assert both.returncode == 2 and "--split or --data" in both.stderr
-    alone = subprocess.run([ARA, "eval", "ablation", "--examples", str(data),
-                            "--out", str(tmp_path / "b")], capture_output=True, text=True)
+    alone = run_ara("eval", "ablation", "--examples", str(data), "--out", str(tmp_path / "b"))
     assert alone.returncode == 2 and "--examples goes with --data" in alone.stderr
 
 
@@ -152,11 +151,10 @@ def test_cli_names_what_cannot_be_planned_before_loading_a_model(tmp_path):
     examples than the examples file holds (each before a model would load)."""
     data = write(tmp_path / "mine.jsonl", PAIRS[:2])
     examples = write(tmp_path / "ex.jsonl", PAIRS[2:])
-    base = [ARA, "eval", "ablation", "--data", str(data), "--out", str(tmp_path / "run")]
-    form = subprocess.run([*base, "--form", "lifted"], capture_output=True, text=True)
+    base = ["eval", "ablation", "--data", str(data), "--out", str(tmp_path / "run")]
+    form = run_ara(*base, "--form", "lifted")
     assert form.returncode == 2 and "mine.jsonl has no lifted lines" in form.stderr
-    shots = subprocess.run([*base, "--examples", str(examples), "--variants", "F+C",
-                            "--shots", "5"], capture_output=True, text=True)
+    shots = run_ara(*base, "--examples", str(examples), "--variants", "F+C", "--shots", "5")
     assert shots.returncode == 2 and "5 worked examples asked for" in shots.stderr
     assert "only 1 to draw them from" in shots.stderr
     assert not (tmp_path / "run").exists()
@@ -184,7 +182,7 @@ def test_an_ablation_on_ones_own_file_is_judged_reported_and_resumed(tmp_path):
     assert all(s["valid"] for s in samples if s["variant"] == "C")
 
     write(data, PAIRS[:2])
-    resumed = subprocess.run([*args, "--resume"], capture_output=True, text=True, timeout=600)
+    resumed = run_ara(*args[1:], "--resume")
     assert resumed.returncode == 2 and "different data" in resumed.stderr
 
 
