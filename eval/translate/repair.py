@@ -219,8 +219,9 @@ def translate_repaired(translator: Translator, nl: str, aps: Sequence[str],
     Returns:
         A :class:`Vote` of one answer when the greedy one leaves nothing out (and is
         not doubted), ``samples`` is 0, or the backend can neither score nor sample (an
-        HTTP server); a backend that cannot sample draws none. Otherwise of all answers considered, greedy first. With a gap,
-        the greedy answer wins unless another leaves out less. Ranked by score, answers
+        HTTP server); a backend that cannot sample draws none. Otherwise of all answers
+        considered, greedy first. With a gap, the greedy answer wins unless another
+        leaves out less. Ranked by score, answers
         of the same text share a group, best score first; a mended answer's result is
         the greedy one's with the formula replaced (timings and token counts are the
         greedy call's).

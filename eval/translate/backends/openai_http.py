@@ -55,6 +55,10 @@ class OpenAIBackend:
 
     #: Requests may be in flight at once (``--concurrency``): the server batches them.
     concurrent = True
+    #: Seeded sampling under a grammar is not a call these servers share; repair reads
+    #: this and keeps the greedy answer instead of failing.
+    can_sample = False
+
     def __init__(self, base_url: str, model: str = "default", api: str = "completions",
                  timeout_s: float = 120.0, server: str = "openai") -> None:
         if api not in ("completions", "chat"):
@@ -64,10 +68,6 @@ class OpenAIBackend:
         self.base_url = base_url.rstrip("/").removesuffix("/v1")
         self.model, self.api, self.timeout_s, self.server = model, api, timeout_s, server
         self.model_id = f"http:{self.base_url}:{model}"
-
-    #: Seeded sampling under a grammar is not a call these servers share; repair reads
-    #: this and keeps the greedy answer instead of failing.
-    can_sample = False
 
     def _post(self, path: str, body: dict) -> dict:
         headers = {"Content-Type": "application/json"}
