@@ -216,8 +216,9 @@ class TrainConfig:
         eval_pairs: Test pairs for the held-out check at the end (0: none).
         precision: What the frozen base model computes in: ``bf16``, ``fp32``, or
             ``auto`` (default): bf16 where the hardware multiplies it natively (a CUDA
-            GPU since Ampere; a CPU with AMX, Intel Xeon since Sapphire Rapids), fp32
-            elsewhere (without them bf16 is emulated, slowly). The LoRA weights and the
+            GPU since Ampere; a CPU with AMX or AVX512-BF16, such as Intel Xeon since
+            Sapphire Rapids and AMD EPYC since Zen 4), fp32 elsewhere (without them bf16
+            is emulated, slowly). The LoRA weights and the
             optimizer stay fp32, and the loss is taken in fp32. It is no part of what a
             run trains (a recipe stage's identity leaves it out): a resumed run may go on
             in another, on another machine; each log line records the one of its step.

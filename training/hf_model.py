@@ -38,9 +38,11 @@ def training_dtype(precision: str, device):
         if device.type == "cuda":
             native = torch.cuda.is_bf16_supported(including_emulation=False)
         else:
-            # AMX multiplies bf16 natively; without it bf16 is converted and loses to fp32.
-            native = device.type == "cpu" and getattr(
-                torch.cpu, "_is_amx_tile_supported", lambda: False)()
+            # AMX and AVX512-BF16 multiply bf16 natively (bench/training_step_cost.py);
+            # without either bf16 is converted and loses to fp32.
+            native = device.type == "cpu" and any(
+                getattr(torch.cpu, probe, lambda: False)()
+                for probe in ("_is_amx_tile_supported", "_is_avx512_bf16_supported"))
         precision = "bf16" if native else "fp32"
     return torch.bfloat16 if precision == "bf16" else torch.float32
 

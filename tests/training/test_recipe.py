@@ -13,8 +13,8 @@ from ara.training.recipe import LoRAFinetuneRecipe, run_training
 
 
 def tiny_config(model_dir, out, **overrides):
-    # fp32 everywhere: "auto" would take bf16 on a CPU with AMX, and equalities of losses
-    # across runs need one precision on every machine.
+    # fp32 everywhere: "auto" takes bf16 on a CPU with AMX or AVX512-BF16, and equalities
+    # of losses across runs need one precision on every machine.
     base = {"base_model": model_dir, "out": str(out), "seed": 0, "checkpoint_every": 3,
             "eval_pairs": 0, "max_steps": 6, "precision": "fp32",
             "lora": {"r": 4, "alpha": 8, "dropout": 0.0},
