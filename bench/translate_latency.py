@@ -6,9 +6,10 @@ fine-tune, measured side by side in one run on the same sentences.
 Rows: the earlier default (paper-split adapter, grammar without time bounds), the new
 default (compositional adapter; intervals use 0 and the numbers the sentence writes),
 the same adapter with any bound up to 1000 (a grammar of two rules per number, which
-llguidance compiles for every new set of propositions), and without time bounds. Zero-shot, greedy,
-under the grammar, on ``--n`` hand-written grounded instructions (seed 0), one warm-up
-call first. A formula's time depends on its length, so tokens per answer are shown too.
+llguidance compiles for every new set of propositions), and without time bounds.
+Zero-shot, greedy, under the grammar, on ``--n`` hand-written grounded instructions
+(seed 0), one warm-up call first; the rows take turns sentence by sentence. A formula's
+time depends on its length, so tokens per answer are shown too.
 Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
 with the default grammar, so a candidate is timed beside what ships, in the same run.
 ``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`),
@@ -28,6 +29,9 @@ import platform
 import random
 import statistics
 import time
+from collections.abc import Callable
+
+from tqdm import tqdm
 
 from ara.data import load_or_prepare
 from ara.eval.translate.answering import answer
@@ -36,29 +40,21 @@ from ara.eval.translate.repair import REPAIR_BY, RepairConfig, translate_repaire
 from ara.eval.translate.translator import Translator, TranslatorConfig
 
 
-def measure(translator: Translator, records, repair: int = 0, by: str = REPAIR_BY[0],
-            command: bool = False) -> dict:
-    translator.translate(records[0].nl, records[0].aps)  # warm: load, compile the grammar
-    if command:  # what `ara translate` does, as it does it
-        ms = []
-        for r in records:
-            start = time.perf_counter()
+def timer(translator: Translator, repair: int = 0, by: str = REPAIR_BY[0],
+          command: bool = False) -> Callable:
+    """One timed answer of a row: its milliseconds and completion tokens (None for the
+    whole command, whose answers are several)."""
+    def one(r) -> tuple[float, float | None]:
+        start = time.perf_counter()
+        if command:  # what `ara translate` does, as it does it
             answer(translator, r.nl, r.aps)
-            ms.append((time.perf_counter() - start) * 1e3)
-        return {"median_ms": statistics.median(ms), "mean_ms": statistics.fmean(ms),
-                "tokens": None}
-    if repair:
-        runs, ms = [], []
-        for r in records:
-            start = time.perf_counter()
+            return (time.perf_counter() - start) * 1e3, None
+        if repair:
             vote = translate_repaired(translator, r.nl, r.aps, repair=RepairConfig(repair, by))
-            runs.append(vote.result)
-            ms.append((time.perf_counter() - start) * 1e3)
-    else:
-        runs = [translator.translate(r.nl, r.aps) for r in records]
-        ms = [r.ms for r in runs]
-    return {"median_ms": statistics.median(ms), "mean_ms": statistics.fmean(ms),
-            "tokens": statistics.fmean(r.completion_tokens for r in runs)}
+            return (time.perf_counter() - start) * 1e3, vote.result.completion_tokens
+        result = translator.translate(r.nl, r.aps)
+        return result.ms, result.completion_tokens
+    return one
 
 
 def main() -> None:
@@ -72,11 +68,6 @@ def main() -> None:
     args = ap.parse_args()
     records = random.Random(0).sample(load_or_prepare("handwritten").records("test", "grounded"),
                                       args.n)
-    print(f"# {args.n} hand-written grounded instructions, zero-shot, greedy, constrained; "
-          f"{platform.machine()}, {os.cpu_count()} cores")
-    print("| model | grammar | median ms/formula | mean ms/formula | tokens/answer | "
-          "median vs earlier default |")
-    print("|---|---|---:|---:|---:|---:|")
     rows = [("finetuned-paper", TranslatorConfig(intervals=False), "earlier default",
              "no time bounds", 0),
             ("finetuned", TranslatorConfig(), "default", "bounds the sentence writes", 0),
@@ -93,15 +84,35 @@ def main() -> None:
              0),
             *[(model, TranslatorConfig(), "candidate", "bounds the sentence writes", 0)
               for model in args.candidate]]
-    base = None
-    for model, config, label, grammar, repair in rows:
-        t = Translator(make_backend(model), config)
-        m = measure(t, records, *(repair or (0,)))
-        base = base or m["median_ms"]
-        tokens = "-" if m["tokens"] is None else f"{m['tokens']:.1f}"
-        print(f"| {model} ({label}) | {grammar} | "
-              f"{m['median_ms']:.0f} | {m['mean_ms']:.0f} | {tokens} | "
-              f"{m['median_ms'] / base:.2f} |", flush=True)
+    # Each row has its own backend, warmed (loaded, its grammar compiled) before any timing;
+    # the rows then take turns sentence by sentence, each sentence starting with another row,
+    # so that a machine that slows down mid-run slows every row alike.
+    timers = []
+    for model, config, *_, repair in rows:
+        one = timer(Translator(make_backend(model), config), *(repair or (0,)))
+        one(records[0])
+        timers.append(one)
+    ms: list[list[float]] = [[] for _ in rows]
+    tokens: list[list[float]] = [[] for _ in rows]
+    for i, r in enumerate(tqdm(records, desc="sentences", unit="sentence")):
+        for k in [(i + j) % len(rows) for j in range(len(rows))]:
+            took, count = timers[k](r)
+            ms[k].append(took)
+            if count is not None:
+                tokens[k].append(count)
+    print(f"# {args.n} hand-written grounded instructions, zero-shot, greedy, constrained; "
+          f"rows interleaved sentence by sentence; {platform.machine()}, "
+          f"{os.cpu_count()} cores")
+    print("| model | grammar | median ms/formula | mean ms/formula | tokens/answer | "
+          "median vs earlier default |")
+    print("|---|---|---:|---:|---:|---:|")
+    base = statistics.median(ms[0])
+    for (model, _, label, grammar, _), row_ms, row_tokens in zip(rows, ms, tokens,
+                                                                  strict=True):
+        median = statistics.median(row_ms)
+        count = f"{statistics.fmean(row_tokens):.1f}" if row_tokens else "-"
+        print(f"| {model} ({label}) | {grammar} | {median:.0f} | "
+              f"{statistics.fmean(row_ms):.0f} | {count} | {median / base:.2f} |")
 
 
 if __name__ == "__main__":

@@ -5,8 +5,8 @@
         --name gemma3-270m-nl2tl-paper-lora.gguf --split paper --despite "judged by Table I"
 
 EXPORT is the recipe's export stage, or a run folder that `ara export --lora-gguf` wrote
-into (its `export/`). The adapter is copied into `eval/models/NAME` (and as PEFT into
-`NAME-peft/`, which `init_adapter: finetuned` reads) beside a record of what produced it
+into (its `export/`). The adapter is copied into `eval/models/NAME` (a warm start from it,
+`init_adapter: finetuned`, converts it back to PEFT) beside a record of what produced it
 (the run, the recipe's record of every stage, the export with its parity, the held-out
 check) and the parity of what a user runs: the embedded Q4_K_M base plus this adapter
 (llama.cpp) against the merged fp32 model (transformers), greedy, on 20 lifted and 20
@@ -28,10 +28,7 @@ import sys
 from pathlib import Path
 
 from ara.errors import AraError, ConfigError
-from ara.eval.translate.models import FINETUNED_LORA, peft_folder
-
-#: What a PEFT adapter folder needs, of what a run's ``adapter/`` holds.
-PEFT_FILES = ("adapter_config.json", "adapter_model.safetensors")
+from ara.eval.translate.models import FINETUNED_LORA
 
 
 def export_folders(path: Path) -> tuple[Path, Path]:
@@ -39,7 +36,7 @@ def export_folders(path: Path) -> tuple[Path, Path]:
     export = path / "export" if (path / "export" / "lora.gguf").is_file() else path
     run = path if (path / "run.json").is_file() else export
     for need in (export / "lora.gguf", export / "export.json", export / "merged-hf",
-                 run / "run.json", *(run / "adapter" / part for part in PEFT_FILES)):
+                 run / "run.json"):
         if not need.exists():
             raise ConfigError(f"{path}: no {need.name}; export the run first "
                               "(`ara export --run RUN --quant f16 --lora-gguf`)")
@@ -121,12 +118,6 @@ def ship(path: Path, name: str, split: str, min_agreement: float, pairs: int = 2
                           f"{min_agreement:.0%}: not shipped")
     target = SHIPPED / name
     shutil.copyfile(export / "lora.gguf", target)
-    # The same weights as PEFT, which a warm start from the shipped file reads
-    # (`init_adapter: finetuned`): the two must never come from different runs.
-    peft = peft_folder(target)
-    peft.mkdir(exist_ok=True)
-    for part in PEFT_FILES:
-        shutil.copyfile(run / "adapter" / part, peft / part)
     heldout = run / "heldout.json"
     manifest = {"file": name, "sha256": sha256_file(target),
                 "run": json.loads((run / "run.json").read_text()),

@@ -14,7 +14,7 @@ from pathlib import Path
 import yaml
 
 from ara.errors import ConfigError, refuse_unknown_keys
-from ara.eval.translate.models import FINETUNED_LORA, peft_folder
+from ara.eval.translate.models import FINETUNED_LORA
 
 
 def read_config(path: str | Path) -> dict:
@@ -64,9 +64,9 @@ def _build(cls, data: dict | None, where: str):
     return cls(**data)
 
 
-#: The shipped adapters in the PEFT form a warm start (``init_adapter: finetuned``) reads,
-#: by ``--model`` name, beside their GGUF.
-SHIPPED_PEFT = {"finetuned": peft_folder(FINETUNED_LORA)}
+#: The shipped adapters a warm start may name (``init_adapter: finetuned``), by ``--model``
+#: name.
+SHIPPED_ADAPTERS = {"finetuned": FINETUNED_LORA}
 #: ``precision`` values (``auto`` picks by machine: :func:`hf_model.training_dtype`).
 PRECISIONS = ("auto", "bf16", "fp32")
 #: Run settings that leave the adapter as it is: how often a run checkpoints, how many
@@ -259,10 +259,15 @@ class TrainConfig:
 
     @property
     def init_adapter_folder(self) -> Path | None:
-        """Where ``init_adapter`` is: a folder, or the shipped adapter's by its name."""
+        """Where ``init_adapter`` is: a folder, or by its name a shipped adapter's PEFT form
+        (converted from its GGUF into the cache on first use)."""
         if self.init_adapter is None:
             return None
-        return SHIPPED_PEFT.get(self.init_adapter, Path(self.init_adapter))
+        if self.init_adapter in SHIPPED_ADAPTERS:
+            from ara.training.export import shipped_peft
+
+            return shipped_peft(SHIPPED_ADAPTERS[self.init_adapter])
+        return Path(self.init_adapter)
 
     @classmethod
     def from_dict(cls, data: dict) -> TrainConfig:

@@ -10,6 +10,9 @@
    a few MB that llama.cpp applies on top of the base GGUF.
 5. Write ``export.json``: hashes, base, run.
 
+:func:`peft_from_gguf` goes the other way: a GGUF LoRA back to the PEFT folder a warm
+start reads, so a shipped adapter is one file.
+
 ``parity`` then checks that the exported GGUF, through llama-cpp-python, and the merged
 HF model give the same greedy formula on test pairs.
 """
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tarfile
@@ -122,6 +126,70 @@ def lora_to_gguf(base_dir: str, adapter_dir: str, outfile: Path, outtype: str = 
     _run_converter("convert_lora_to_gguf.py", [adapter_dir, "--base", base_dir,
                                                "--outfile", str(outfile), "--outtype", outtype])
     return outfile
+
+
+#: The Gemma 3 modules an ``all-linear`` LoRA adapts, as ``model.layers.N.`` names them.
+GEMMA3_LINEAR = ("self_attn.q_proj", "self_attn.k_proj", "self_attn.v_proj",
+                 "self_attn.o_proj", "mlp.gate_proj", "mlp.up_proj", "mlp.down_proj")
+
+
+def peft_from_gguf(lora: Path, out: Path) -> Path:
+    """A Gemma 3 GGUF LoRA (:func:`lora_to_gguf`) as a PEFT adapter folder in ``out``: its
+    own weights (f16) under PEFT's names, its rank, alpha and adapted modules. What a warm
+    start from a shipped file reads (``init_adapter: finetuned``).
+
+    Raises:
+        ExportError: If ``lora`` is not a LoRA of Gemma 3 on those modules.
+    """
+    import gguf
+    import numpy as np
+    from peft import LoraConfig
+    from safetensors.numpy import save_file
+
+    reader = gguf.GGUFReader(lora)
+    floats = {gguf.GGMLQuantizationType.F16, gguf.GGMLQuantizationType.F32}
+    meta = {k: f.contents() for k, f in reader.fields.items()
+            if k in ("general.architecture", "adapter.type", "adapter.lora.alpha")}
+    if (meta.get("general.architecture"), meta.get("adapter.type")) != ("gemma3", "lora"):
+        raise ExportError(f"{lora} is not a GGUF LoRA of Gemma 3 ({meta})")
+    tensors = {t.name: t for t in reader.tensors}
+    if {t.tensor_type for t in tensors.values()} - floats:
+        raise ExportError(f"{lora} holds quantized tensors: export the LoRA in f16 or f32")
+    blocks = 1 + max(int(name.split(".")[1]) for name in tensors)
+    names = gguf.get_tensor_name_map(gguf.MODEL_ARCH.GEMMA3, blocks)
+    weights, adapted = {}, set()
+    for block in range(blocks):
+        for module in GEMMA3_LINEAR:
+            hf = f"model.layers.{block}.{module}"
+            layer = names.get_name(f"{hf}.weight", try_suffixes=(".weight",))
+            for part in ("a", "b"):
+                tensor = tensors.pop(f"{layer}.lora_{part}", None)
+                if tensor is not None:
+                    # GGUF lists a shape innermost first; the bytes are PEFT's row-major.
+                    weights[f"base_model.model.{hf}.lora_{part.upper()}.weight"] = np.asarray(
+                        tensor.data, dtype=np.float16).reshape(tensor.shape[::-1].tolist())
+                    adapted.add(module.rpartition(".")[2])
+    if tensors or not weights:
+        raise ExportError(f"{lora} has tensors no Gemma 3 linear layer takes: "
+                          f"{sorted(tensors)[:3] or 'none at all'}")
+    rank = next(iter(weights.values())).shape[0]
+    out.mkdir(parents=True, exist_ok=True)
+    LoraConfig(r=rank, lora_alpha=float(meta["adapter.lora.alpha"]), lora_dropout=0.0,
+               target_modules=sorted(adapted), task_type="CAUSAL_LM").save_pretrained(out)
+    save_file(weights, str(out / "adapter_model.safetensors"), metadata={"format": "pt"})
+    return out
+
+
+def shipped_peft(lora: Path) -> Path:
+    """:func:`peft_from_gguf` of a shipped GGUF LoRA, built once into the cache and named by
+    the file's hash, so a file shipped later is converted anew."""
+    out = cache_root() / "peft" / f"{lora.stem}-{sha256_file(lora)[:16]}"
+    if not (out / "adapter_model.safetensors").is_file():
+        partial = out.with_name(out.name + ".partial")  # a kill mid-write leaves no folder
+        if partial.exists():
+            shutil.rmtree(partial)
+        peft_from_gguf(lora, partial).rename(out)
+    return out
 
 
 def export_run(run_dir: Path, quants: tuple[str, ...] = ("f16",), lora_gguf: bool = False,

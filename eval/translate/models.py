@@ -31,12 +31,6 @@ PAPER_LORA = SHIPPED / "gemma3-270m-nl2tl-paper-lora.gguf"
 SHIPPED_ADAPTERS = {"finetuned": FINETUNED_LORA, "finetuned-paper": PAPER_LORA}
 
 
-def peft_folder(gguf: Path) -> Path:
-    """Where a shipped GGUF adapter's PEFT form lives (beside it, ``NAME-peft/``): what a
-    warm start and the transformers backend read."""
-    return gguf.with_name(f"{gguf.stem}-peft")
-
-
 def default_model_path() -> str:
     """Path of the embedded Gemma 3 270M Q4_K_M GGUF (``--model default``; assembled from
     its PyPI package on first use)."""

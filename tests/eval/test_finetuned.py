@@ -38,6 +38,51 @@ def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
     assert manifest["export"]["parity"]["agreement"] == 1.0
 
 
+def test_the_shipped_file_converts_back_to_the_peft_adapter_a_warm_start_reads(tmp_path):
+    """Tests the PEFT form of the shipped GGUF (`init_adapter: finetuned`): every tensor
+    under PEFT's name with the GGUF's own weights, and the rank, alpha and modules the
+    run that made it trained."""
+    if not FINETUNED_LORA.is_file():
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
+    gguf = pytest.importorskip("gguf")
+    import numpy as np
+    from safetensors.numpy import load_file
+
+    from ara.training.export import peft_from_gguf
+
+    folder = peft_from_gguf(FINETUNED_LORA, tmp_path / "peft")
+    weights = load_file(folder / "adapter_model.safetensors")
+    shipped = gguf.GGUFReader(FINETUNED_LORA).tensors
+    assert len(weights) == len(shipped) == 18 * 7 * 2  # 18 blocks, 7 linear layers, A and B
+    q = weights["base_model.model.model.layers.5.self_attn.q_proj.lora_B.weight"]
+    in_gguf = next(t for t in shipped if t.name == "blk.5.attn_q.weight.lora_b")
+    assert q.shape == (1024, 16) and np.array_equal(q, np.asarray(in_gguf.data).reshape(q.shape))
+    config = json.loads((folder / "adapter_config.json").read_text())
+    trained = json.loads(FINETUNED_LORA.with_suffix(".json").read_text())["run"]["config"]["lora"]
+    assert (config["r"], config["lora_alpha"]) == (trained["r"], trained["alpha"])
+    assert sorted(config["target_modules"]) == ["down_proj", "gate_proj", "k_proj", "o_proj",
+                                                "q_proj", "up_proj", "v_proj"]
+
+
+def test_a_gguf_that_is_no_lora_is_refused(tmp_path):
+    """Tests that converting a model's weights, not an adapter's, says what it is."""
+    gguf = pytest.importorskip("gguf")
+    import numpy as np
+
+    from ara.training.export import ExportError, peft_from_gguf
+
+    model = tmp_path / "model.gguf"
+    writer = gguf.GGUFWriter(model, "gemma3")
+    writer.add_tensor("blk.0.attn_q.weight", np.zeros((4, 4), dtype=np.float16))
+    writer.write_header_to_file()
+    writer.write_kv_data_to_file()
+    writer.write_tensors_to_file()
+    writer.close()
+    with pytest.raises(ExportError, match="not a GGUF LoRA of Gemma 3"):
+        peft_from_gguf(model, tmp_path / "peft")
+    assert not (tmp_path / "peft").exists()
+
+
 def correct(backend, pairs, shots=()) -> int:
     t = Translator(backend)
     return sum(bool(judge(stl, t.translate(nl, aps, shots).stl, timeout_s=10)["equivalent"])

@@ -275,6 +275,18 @@ def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tm
     ours, _ = llama._feed_prompt(tokens)
     theirs, _ = hf._feed_prompt(tokens)
     assert np.corrcoef(ours, theirs)[0, 1] > 0.999
+    # The GGUF LoRA read back as PEFT, as a warm start from a shipped file reads it: the
+    # trained weights under their own names, to f16's precision.
+    from safetensors.numpy import load_file
+
+    from ara.training.export import peft_from_gguf
+
+    back = load_file(peft_from_gguf(export / "lora.gguf", tmp_path / "peft")
+                     / "adapter_model.safetensors")
+    trained = load_file(tmp_path / "run" / "adapter" / "adapter_model.safetensors")
+    assert back.keys() == trained.keys()
+    for name, weights in trained.items():
+        np.testing.assert_allclose(back[name], weights, rtol=1e-3, atol=1e-6, err_msg=name)
 
 
 @pytest.mark.slow  # a speed-up's equivalence; the golden losses pin training in the default tier
