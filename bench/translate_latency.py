@@ -12,6 +12,7 @@ Zero-shot, greedy, under the grammar, on ``--n`` hand-written grounded instructi
 time depends on its length, so tokens per answer are shown too.
 Each ``--candidate`` (any ``--model`` value, e.g. an adapter not shipped yet) adds a row
 with the default grammar, so a candidate is timed beside what ships, in the same run.
+Every row keeps its own model loaded for the whole run (about 300 MB each).
 ``--repair K`` (default 8) adds the default with repair (`ara translate --repair K`),
 by samples+edits (the default; it also draws for a complete answer the model doubts),
 by edits and by samples: its median is the greedy answer's, its mean carries the extra
@@ -94,13 +95,22 @@ def main() -> None:
         timers.append(one)
     ms: list[list[float]] = [[] for _ in rows]
     tokens: list[list[float]] = [[] for _ in rows]
-    for i, r in enumerate(tqdm(records, desc="sentences", unit="sentence")):
-        for k in [(i + j) % len(rows) for j in range(len(rows))]:
-            took, count = timers[k](r)
-            ms[k].append(took)
-            if count is not None:
-                tokens[k].append(count)
-    print(f"# {args.n} hand-written grounded instructions, zero-shot, greedy, constrained; "
+    done = 0
+    try:
+        for i, r in enumerate(tqdm(records, desc="sentences", unit="sentence")):
+            for k in [(i + j) % len(rows) for j in range(len(rows))]:
+                took, count = timers[k](r)
+                ms[k].append(took)
+                if count is not None:
+                    tokens[k].append(count)
+            done += 1
+    except KeyboardInterrupt:  # the sentences every row has answered still make a table
+        print(f"interrupted: the table below is of the first {done} sentences")
+        ms = [row[:done] for row in ms]
+        tokens = [row[:done] for row in tokens]
+    if not done:
+        return
+    print(f"# {done} hand-written grounded instructions, zero-shot, greedy, constrained; "
           f"rows interleaved sentence by sentence; {platform.machine()}, "
           f"{os.cpu_count()} cores")
     print("| model | grammar | median ms/formula | mean ms/formula | tokens/answer | "

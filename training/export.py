@@ -133,62 +133,86 @@ GEMMA3_LINEAR = ("self_attn.q_proj", "self_attn.k_proj", "self_attn.v_proj",
                  "self_attn.o_proj", "mlp.gate_proj", "mlp.up_proj", "mlp.down_proj")
 
 
+#: The version of :func:`peft_from_gguf`'s output, part of the cache's folder names: a
+#: change to what it writes must not meet a folder an earlier release converted.
+PEFT_FROM_GGUF_VERSION = 1
+
+
 def peft_from_gguf(lora: Path, out: Path) -> Path:
     """A Gemma 3 GGUF LoRA (:func:`lora_to_gguf`) as a PEFT adapter folder in ``out``: its
-    own weights (f16) under PEFT's names, its rank, alpha and adapted modules. What a warm
-    start from a shipped file reads (``init_adapter: finetuned``).
+    own weights, in their own precision, under PEFT's names, with its rank, alpha and
+    adapted modules. What a warm start from a shipped file reads (``init_adapter: finetuned``).
 
     Raises:
-        ExportError: If ``lora`` is not a LoRA of Gemma 3 on those modules.
+        ExportError: If ``lora`` is not an f16 or f32 LoRA of Gemma 3's linear layers,
+            with A and B of one rank for each.
     """
+    import re
+
     import gguf
     import numpy as np
     from peft import LoraConfig
     from safetensors.numpy import save_file
 
     reader = gguf.GGUFReader(lora)
-    floats = {gguf.GGMLQuantizationType.F16, gguf.GGMLQuantizationType.F32}
     meta = {k: f.contents() for k, f in reader.fields.items()
             if k in ("general.architecture", "adapter.type", "adapter.lora.alpha")}
     if (meta.get("general.architecture"), meta.get("adapter.type")) != ("gemma3", "lora"):
         raise ExportError(f"{lora} is not a GGUF LoRA of Gemma 3 ({meta})")
+    if "adapter.lora.alpha" not in meta:
+        raise ExportError(f"{lora} does not say its LoRA alpha (adapter.lora.alpha)")
     tensors = {t.name: t for t in reader.tensors}
-    if {t.tensor_type for t in tensors.values()} - floats:
-        raise ExportError(f"{lora} holds quantized tensors: export the LoRA in f16 or f32")
-    blocks = 1 + max(int(name.split(".")[1]) for name in tensors)
+    floats = {gguf.GGMLQuantizationType.F16, gguf.GGMLQuantizationType.F32}
+    if odd := sorted(t.name for t in tensors.values() if t.tensor_type not in floats):
+        raise ExportError(f"{lora} holds tensors neither f16 nor f32 ({odd[:3]}): export the "
+                          "LoRA with --outtype f16 or f32")
+    blocks = 1 + max((int(m[1]) for name in tensors if (m := re.match(r"blk\.(\d+)\.", name))),
+                     default=-1)
     names = gguf.get_tensor_name_map(gguf.MODEL_ARCH.GEMMA3, blocks)
-    weights, adapted = {}, set()
+    weights, adapted, ranks = {}, set(), set()
     for block in range(blocks):
         for module in GEMMA3_LINEAR:
             hf = f"model.layers.{block}.{module}"
             layer = names.get_name(f"{hf}.weight", try_suffixes=(".weight",))
-            for part in ("a", "b"):
-                tensor = tensors.pop(f"{layer}.lora_{part}", None)
-                if tensor is not None:
-                    # GGUF lists a shape innermost first; the bytes are PEFT's row-major.
-                    weights[f"base_model.model.{hf}.lora_{part.upper()}.weight"] = np.asarray(
-                        tensor.data, dtype=np.float16).reshape(tensor.shape[::-1].tolist())
-                    adapted.add(module.rpartition(".")[2])
+            a, b = tensors.pop(f"{layer}.lora_a", None), tensors.pop(f"{layer}.lora_b", None)
+            if a is None and b is None:
+                continue
+            if a is None or b is None:
+                raise ExportError(f"{lora}: {layer} has lora_{'b' if a is None else 'a'} "
+                                  "without its other half")
+            for part, tensor in (("A", a), ("B", b)):
+                # The reader gives each tensor as PEFT lays it out (out x in), row-major.
+                weights[f"base_model.model.{hf}.lora_{part}.weight"] = np.array(tensor.data)
+            ranks |= {weights[f"base_model.model.{hf}.lora_A.weight"].shape[0],
+                      weights[f"base_model.model.{hf}.lora_B.weight"].shape[1]}
+            adapted.add(module.rpartition(".")[2])
     if tensors or not weights:
         raise ExportError(f"{lora} has tensors no Gemma 3 linear layer takes: "
                           f"{sorted(tensors)[:3] or 'none at all'}")
-    rank = next(iter(weights.values())).shape[0]
+    if len(ranks) != 1:
+        raise ExportError(f"{lora} mixes LoRA ranks {sorted(ranks)}")
     out.mkdir(parents=True, exist_ok=True)
-    LoraConfig(r=rank, lora_alpha=float(meta["adapter.lora.alpha"]), lora_dropout=0.0,
+    LoraConfig(r=ranks.pop(), lora_alpha=float(meta["adapter.lora.alpha"]), lora_dropout=0.0,
                target_modules=sorted(adapted), task_type="CAUSAL_LM").save_pretrained(out)
     save_file(weights, str(out / "adapter_model.safetensors"), metadata={"format": "pt"})
     return out
 
 
 def shipped_peft(lora: Path) -> Path:
-    """:func:`peft_from_gguf` of a shipped GGUF LoRA, built once into the cache and named by
-    the file's hash, so a file shipped later is converted anew."""
-    out = cache_root() / "peft" / f"{lora.stem}-{sha256_file(lora)[:16]}"
-    if not (out / "adapter_model.safetensors").is_file():
-        partial = out.with_name(out.name + ".partial")  # a kill mid-write leaves no folder
-        if partial.exists():
-            shutil.rmtree(partial)
-        peft_from_gguf(lora, partial).rename(out)
+    """:func:`peft_from_gguf` of a shipped GGUF LoRA, converted once into the cache under
+    the file's hash (a file shipped later is converted anew). One process converts at a
+    time; the others wait for its folder."""
+    import fcntl
+
+    root = cache_root() / "peft"
+    out = root / f"{lora.stem}-{sha256_file(lora)[:16]}-v{PEFT_FROM_GGUF_VERSION}"
+    root.mkdir(parents=True, exist_ok=True)
+    with open(root / f"{out.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (out / "adapter_model.safetensors").is_file():
+            partial = out.with_name(out.name + ".partial")  # a kill mid-write leaves no `out`
+            shutil.rmtree(partial, ignore_errors=True)
+            peft_from_gguf(lora, partial).rename(out)
     return out
 
 

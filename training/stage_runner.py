@@ -211,8 +211,8 @@ def _run_stage(recipe: StagedRecipe, stage: Stage, resume: bool,
     if folder.exists():
         shutil.rmtree(folder)
     shutil.move(str(source / "export"), str(folder))
-    # With the record of the run it exports and its adapter (shipped as PEFT beside the
-    # GGUF), the folder is all that shipping needs.
+    # With the record of the run it exports, the folder is all that shipping needs; its
+    # adapter stays beside it for a warm start from the candidate (`init_adapter`).
     shutil.copyfile(source / "run.json", folder / "run.json")
     shutil.copytree(source / "adapter", folder / "adapter")
     return {"files": manifest["files"], "parity": manifest.get("parity")}

@@ -29,7 +29,8 @@ from pathlib import Path
 from typing import Any
 
 from ara.errors import ConfigError, did_you_mean, refuse_unknown_keys
-from ara.training.config import BOOKKEEPING, TrainConfig
+from ara.provenance import sha256_file
+from ara.training.config import BOOKKEEPING, SHIPPED_ADAPTERS, TrainConfig
 from ara.training.export import PARITY_PAIRS
 from ara.training.run_folder import adapter_identity
 from ara.training.soup import check_soup
@@ -153,8 +154,11 @@ class StagedRecipe:
                 if config.data.pairs:
                     settings["data"]["pairs_sha256"] = _file_hash(config.data.pairs)
                 if config.init_adapter and not stage.inputs:
+                    # A shipped file by its own hash: `--status` converts nothing.
+                    shipped = SHIPPED_ADAPTERS.get(config.init_adapter)
                     settings["init_adapter_sha256"] = (
-                        adapter_identity(config.init_adapter_folder) or {}).get("sha256")
+                        sha256_file(shipped) if shipped else
+                        (adapter_identity(config.init_adapter_folder) or {}).get("sha256"))
             blob = json.dumps({"kind": stage.kind, "settings": settings,
                                "inputs": [prints[name] for name in stage.inputs]},
                               sort_keys=True)

@@ -38,10 +38,15 @@ def test_each_adapter_is_the_one_its_manifest_describes(adapter, version):
     assert manifest["export"]["parity"]["agreement"] == 1.0
 
 
+#: llama.cpp's names for the layers of a Gemma 3 block a LoRA adapts, by PEFT's.
+GGUF_LAYERS = {"self_attn.q_proj": "attn_q", "self_attn.k_proj": "attn_k",
+               "self_attn.v_proj": "attn_v", "self_attn.o_proj": "attn_output",
+               "mlp.gate_proj": "ffn_gate", "mlp.up_proj": "ffn_up", "mlp.down_proj": "ffn_down"}
+
+
 def test_the_shipped_file_converts_back_to_the_peft_adapter_a_warm_start_reads(tmp_path):
-    """Tests the PEFT form of the shipped GGUF (`init_adapter: finetuned`): every tensor
-    under PEFT's name with the GGUF's own weights, and the rank, alpha and modules the
-    run that made it trained."""
+    """Tests the PEFT form of the shipped GGUF (`init_adapter: finetuned`): each of its
+    tensors under PEFT's name with the GGUF's own weights, and its rank and alpha."""
     if not FINETUNED_LORA.is_file():
         pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
     gguf = pytest.importorskip("gguf")
@@ -52,16 +57,41 @@ def test_the_shipped_file_converts_back_to_the_peft_adapter_a_warm_start_reads(t
 
     folder = peft_from_gguf(FINETUNED_LORA, tmp_path / "peft")
     weights = load_file(folder / "adapter_model.safetensors")
-    shipped = gguf.GGUFReader(FINETUNED_LORA).tensors
-    assert len(weights) == len(shipped) == 18 * 7 * 2  # 18 blocks, 7 linear layers, A and B
-    q = weights["base_model.model.model.layers.5.self_attn.q_proj.lora_B.weight"]
-    in_gguf = next(t for t in shipped if t.name == "blk.5.attn_q.weight.lora_b")
-    assert q.shape == (1024, 16) and np.array_equal(q, np.asarray(in_gguf.data).reshape(q.shape))
+    reader = gguf.GGUFReader(FINETUNED_LORA)
+    shipped = {t.name: np.asarray(t.data) for t in reader.tensors}
+    assert len(weights) == len(shipped) == 18 * len(GGUF_LAYERS) * 2  # 18 blocks, A and B
+    for block in range(18):
+        for module, layer in GGUF_LAYERS.items():
+            for part in "AB":
+                ours = f"base_model.model.model.layers.{block}.{module}.lora_{part}.weight"
+                theirs = f"blk.{block}.{layer}.weight.lora_{part.lower()}"
+                assert np.array_equal(weights[ours], shipped[theirs]), ours
     config = json.loads((folder / "adapter_config.json").read_text())
-    trained = json.loads(FINETUNED_LORA.with_suffix(".json").read_text())["run"]["config"]["lora"]
-    assert (config["r"], config["lora_alpha"]) == (trained["r"], trained["alpha"])
-    assert sorted(config["target_modules"]) == ["down_proj", "gate_proj", "k_proj", "o_proj",
-                                                "q_proj", "up_proj", "v_proj"]
+    alpha = reader.fields["adapter.lora.alpha"].contents()
+    assert (config["r"], config["lora_alpha"]) == (16, alpha)
+    assert sorted(config["target_modules"]) == sorted(m.split(".")[1] for m in GGUF_LAYERS)
+
+
+def test_a_warm_start_from_the_shipped_file_converts_it_once(tmp_path, monkeypatch):
+    """Tests the cache a warm start reads: converted on first use, found after, and a
+    conversion killed midway leaves nothing the next one takes for done."""
+    if not FINETUNED_LORA.is_file():
+        pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
+    import shutil
+
+    from ara.training.export import shipped_peft
+
+    monkeypatch.setenv("ARA_CACHE", str(tmp_path))
+    folder = shipped_peft(FINETUNED_LORA)
+    written = (folder / "adapter_model.safetensors").stat().st_mtime_ns
+    assert shipped_peft(FINETUNED_LORA) == folder
+    assert (folder / "adapter_model.safetensors").stat().st_mtime_ns == written
+    shutil.rmtree(folder)
+    partial = folder.with_name(folder.name + ".partial")
+    partial.mkdir()
+    (partial / "adapter_config.json").write_text("{")  # as a kill leaves it
+    assert shipped_peft(FINETUNED_LORA) == folder and not partial.exists()
+    assert json.loads((folder / "adapter_config.json").read_text())["r"] == 16
 
 
 def test_a_gguf_that_is_no_lora_is_refused(tmp_path):

@@ -247,7 +247,8 @@ def test_a_warm_start_continues_from_a_finished_adapter(tiny_gemma_dir, tmp_path
 @pytest.mark.slow  # converts and quantizes a 262k-vocabulary model: about a minute
 def test_export_gguf_loads_in_llama_cpp_and_matches_hf_logits(tiny_gemma_dir, tmp_path):
     """Tests train -> merge -> GGUF (f32) -> q8_0 and the GGUF LoRA, then that llama.cpp
-    and transformers compute the same next-token scores from the exported weights.
+    and transformers compute the same next-token scores from the exported weights, and
+    that the GGUF LoRA reads back as the trained adapter.
 
     Random weights give near-uniform scores, so greedy answers are a coin toss under any
     rounding; the score vectors themselves must still agree.
@@ -387,7 +388,7 @@ def test_merging_an_adapter_saved_without_a_tokenizer_takes_the_bases(tiny_gemma
     assert ours("always ( prop_1 )")["input_ids"] == base("always ( prop_1 )")["input_ids"]
 
 
-def test_your_own_pairs_join_the_training_records(tiny_gemma_dir, tmp_path):
+def test_your_own_pairs_join_the_training_records(tiny_gemma_dir, tmp_path, monkeypatch):
     """Tests ``data.pairs``: a user's file becomes training records of the source
     ``pairs``, weighted by ``repeat``, its hash recorded; the shipped adapter is a
     warm start by its name."""
@@ -404,6 +405,7 @@ def test_your_own_pairs_join_the_training_records(tiny_gemma_dir, tmp_path):
     assert sum(r.source == "pairs" for r in recipe.train_records) == 6
     run = json.loads((tmp_path / "run" / "run.json").read_text())
     assert len(run["data"]["pairs_sha256"]) == 64
+    monkeypatch.setenv("ARA_CACHE", str(tmp_path / "cache"))  # where it is converted to PEFT
     shipped = TrainConfig.from_dict({**config.to_dict(), "init_adapter": "finetuned"})
     assert (shipped.init_adapter_folder / "adapter_config.json").is_file()
     # Pairs of a form the run does not train on would be dropped without a word.
