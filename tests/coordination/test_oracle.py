@@ -77,6 +77,16 @@ def test_ils_is_never_worse_than_greedy_nor_better_than_the_optimum(seed):
     assert found.feasible and sorted(j for r in found.routes for j in r) == list(range(13))
 
 
+def test_ils_improves_on_the_greedy_insertion_it_starts_from():
+    """Tests that the search does more than return its start: on this trial greedy
+    insertion leaves the optimum far behind."""
+    trial = make_trial(0, 3002)
+    fleet = Fleet(WORLD, trial.starts, (*trial.jobs, trial.help_job), help_job=12, cap=50)
+    greedy = evaluate(fleet, greedy_insertion(fleet))
+    assert exact(fleet).cost < greedy.cost  # room to improve
+    assert ils(fleet, ILSSettings(iterations=20, seed=3002)).cost < greedy.cost
+
+
 def test_settings_and_fleets_check_their_ranges():
     """A zero temperature accepts improvements only; impossible values are refused."""
     fleet = Fleet(WORLD, ((0, 0), (7, 7)), (Job((0, 2), (0, 3)), Job((7, 5), (7, 6))))

@@ -49,7 +49,7 @@ def test_the_shipped_file_converts_back_to_the_peft_adapter_a_warm_start_reads(t
     tensors under PEFT's name with the GGUF's own weights, and its rank and alpha."""
     if not FINETUNED_LORA.is_file():
         pytest.skip(f"no shipped adapter at {FINETUNED_LORA}")
-    gguf = pytest.importorskip("gguf")
+    gguf = pytest.importorskip("gguf", reason="needs gguf (make setup)")
     import numpy as np
     from safetensors.numpy import load_file
 
@@ -96,7 +96,7 @@ def test_a_warm_start_from_the_shipped_file_converts_it_once(tmp_path, monkeypat
 
 def test_a_gguf_that_is_no_lora_is_refused(tmp_path):
     """Tests that converting a model's weights, not an adapter's, says what it is."""
-    gguf = pytest.importorskip("gguf")
+    gguf = pytest.importorskip("gguf", reason="needs gguf (make setup)")
     import numpy as np
 
     from ara.training.export import ExportError, peft_from_gguf

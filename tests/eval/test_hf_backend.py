@@ -20,7 +20,7 @@ def test_constrained_outputs_belong_to_the_language(hf_backend, paper_split):
         assert result.valid and translator.config.syntax(record.aps).accepts(result.stl), result
 
 
-@pytest.mark.slow  # loads a second model; llama.cpp's prefix reuse is tested in the default tier
+@pytest.mark.slow  # loads a second model, as llama.cpp's prefix-reuse test (slow too) does
 def test_prefix_reuse_gives_the_fresh_answer(hf_backend, hf_model_dir, paper_split):
     """Tests that cropping the cache to the shared prefix changes no answer."""
     from ara.eval.translate.backends.hf_backend import HFBackend

@@ -10,7 +10,8 @@ from ara.eval.translate.backends.base import BackendError, Sampling
 from ara.eval.translate.backends.masking import allowed_tokens
 from ara.eval.translate.prompt import STOP, build_prompt, sample_shots
 from ara.eval.translate.translator import Translator, TranslatorConfig
-from ara.grammars import Syntax, build_grammar
+from ara.grammars import Syntax, build_grammar, parse
+from ara.grammars.ast import interval_of, walk
 
 
 def test_allowed_tokens_unpacks_an_llguidance_bitmask():
@@ -60,21 +61,24 @@ def test_constrained_outputs_always_belong_to_the_language(llama_backend, paper_
 
 
 def test_constrained_timed_outputs_respect_interval_bounds(llama_backend):
-    """Tests the guarantee with intervals: bounds stay within max_bound, lo <= hi."""
+    """Tests the guarantee with intervals: every bound an answer writes stays within
+    max_bound, lo <= hi. (The base model writes no interval unasked, so each answer is
+    required to write the sentence's last number.)"""
     translator = Translator(llama_backend, TranslatorConfig(intervals=True, max_bound=60))
-    for nl in ("within 10 to 20 seconds reach (prop_1) and always avoid (prop_2)",
-               "(prop_1) until (prop_2) between steps 3 and 9"):
-        result = translator.translate(nl, ("prop_1", "prop_2"))
-        syntax = translator.config.syntax(("prop_1", "prop_2"))
-        assert syntax.intervals and syntax.max_bound == 60
-        assert result.valid and syntax.accepts(result.stl), result
+    for nl, last in (("within 10 to 20 seconds reach (prop_1) and always avoid (prop_2)", "20"),
+                     ("(prop_1) until (prop_2) between steps 3 and 9", "9")):
+        result = translator.translate(nl, ("prop_1", "prop_2"), require=(last,))
+        assert result.valid and translator.config.syntax(("prop_1", "prop_2"),
+                                                         nl).accepts(result.stl), result
+        intervals = [iv for node in walk(parse(result.stl)) if (iv := interval_of(node))]
+        assert intervals and all(iv.hi is not None and iv.lo <= iv.hi <= 60
+                                 for iv in intervals), result
 
 
 def test_an_answer_can_be_required_to_write_what_the_request_lists(llama_backend):
     """Tests ``require`` on real generations: every answer names the required
     proposition and bound, and stays in the request's language."""
     from ara.grammars import atoms, parse, walk
-    from ara.grammars.ast import interval_of
 
     translator = Translator(llama_backend)
     nl = "reach (prop_1) within 12 steps, and never (prop_2) or (prop_3)"
@@ -161,7 +165,8 @@ def test_scores_do_not_depend_on_what_else_is_scored(llama_backend):
 @pytest.mark.slow  # two more model loads for a setting
 def test_the_thread_count_comes_from_the_caller_or_ara_threads(embedded_model_path,
                                                                monkeypatch):
-    """Tests ARA_THREADS: beside another busy process, one thread beats all cores."""
+    """Tests that ARA_THREADS sets llama.cpp's thread count (one thread is what to give a
+    model beside another busy process), and that a caller can pass its own."""
     from ara.eval.translate.backends.llama_cpp_backend import LlamaCppBackend
 
     monkeypatch.setenv("ARA_THREADS", "1")

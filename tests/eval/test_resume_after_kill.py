@@ -71,7 +71,7 @@ def test_score_rebuilds_the_report_without_a_model(tmp_path):
     assert "Table I" in (tmp_path / "tables.md").read_text()
 
 
-def test_empty_split_and_missing_model_are_clear_errors(tmp_path):
+def test_a_missing_model_file_and_an_unknown_variant_are_clear_errors(tmp_path):
     """Tests the messages for a model path that does not exist and a bad variant."""
     out = subprocess.run([ARA, *ARGS, "--out", str(tmp_path / "a"), "--model", "/no/such.gguf"],
                          capture_output=True, text=True)

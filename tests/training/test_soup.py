@@ -7,8 +7,8 @@ import pytest
 from ara.errors import ConfigError
 from ara.training.soup import SoupPart, average_adapters, reduce_rank
 
-torch = pytest.importorskip("torch")
-peft = pytest.importorskip("peft")
+torch = pytest.importorskip("torch", reason="needs torch (make setup)")
+peft = pytest.importorskip("peft", reason="needs peft (make setup)")
 
 
 def tiny_model():
