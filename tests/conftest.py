@@ -6,6 +6,7 @@ import importlib.util
 import subprocess
 
 import pytest
+from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 
 from ara.grammars import (
@@ -22,6 +23,11 @@ from ara.grammars import (
     Or,
     Until,
 )
+
+# Drawing formulas can be slow on a busy 2-core machine (CI's): no fault of the code under
+# test, so it is not a failure. Each test's own @settings keeps this.
+settings.register_profile("ara", suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("ara")
 
 
 def intervals(max_bound: int, allow_inf: bool = False) -> st.SearchStrategy[Interval]:

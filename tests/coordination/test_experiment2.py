@@ -28,7 +28,10 @@ def test_paper_instances_are_pinned(seed, site, starts, first_jobs, last_job):
     assert (t.jobs[-1].pick, t.jobs[-1].drop) == last_job
 
 
-def test_trials_are_the_specs_draw():
+def test_a_trial_is_the_seeds_draw_and_the_closest_robot_is_nearest_the_site():
+    """Tests the spec's trial generator (six robots, twelve jobs, a site no robot
+    starts on; the same seed, the same trial), the earlier uniform one, and the robot
+    the nearest-robot baselines pick."""
     t = make_trial(0, 3000)
     assert len(t.starts) == 6 and len(t.jobs) == 12 and t.site not in t.starts
     assert make_trial(0, 3000) == t and make_trial(1, 3001) != t

@@ -75,7 +75,7 @@ def test_timed_rows_keep_their_intervals():
     assert record.stl == "G(prop_1 -> F[12,65](prop_2))" and rejected == []
 
 
-def test_helpers_tidy_sentences_and_names():
+def test_tokens_join_into_a_sentence_and_wordnet_senses_into_a_name():
     """Tests detokenize and grounded_name."""
     assert detokenize("if ( prop_1 ) , then go".split()) == "if (prop_1), then go"
     assert grounded_name(["go_to_v", "waste_basket_n"]) == "go_to_waste_basket"

@@ -36,7 +36,7 @@ def test_bad_nodes_are_refused(build, message):
         build()
 
 
-def test_helpers_read_the_tree():
+def test_atoms_depth_and_largest_bound_are_read_from_the_tree():
     """Tests atoms, depth and max_bound on one formula."""
     until = Until(Atom("b"), Atom("a"), Interval(0, 4))
     f = And((Eventually(Atom("a"), Interval(2, 9)), Not(until)))

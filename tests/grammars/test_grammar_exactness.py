@@ -11,7 +11,7 @@ import random
 
 import lark
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ara.grammars import Syntax, build_grammar, to_text
@@ -72,7 +72,7 @@ def test_every_sampled_string_is_accepted_by_the_parser(language):
         assert syntax.accepts(text), text
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=150, deadline=None)
 @given(tree=formulas(aps=("a", "b", "Fa"), timed=True, max_bound=40, allow_next=True,
                      allow_inf=True),
        seed=st.integers(0, 2**32))
@@ -124,7 +124,7 @@ def test_llama_cpp_gbnf_agrees_with_the_parser_on_samples(gbnf_language):
     assert inside > 150
 
 
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None)
 @given(tree=formulas(aps=("a", "b", "Fa", "p", "q", "prop_1", "prop_10"), timed=True,
                      max_bound=40, allow_next=True),
        seed=st.integers(0, 2**32))
