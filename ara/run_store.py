@@ -32,6 +32,17 @@ def sample_key(sample: dict) -> tuple:
     return tuple(sample[k] for k in KEY_FIELDS)
 
 
+def cut_partial_line(path: Path) -> None:
+    """Drop the last line of an append-only JSON Lines file where an interrupted write
+    left it without its newline (only the last can be), so that appending goes on from a
+    whole line."""
+    data = path.read_bytes()
+    end = data.rfind(b"\n") + 1
+    if end != len(data):
+        with open(path, "r+b") as fh:
+            fh.truncate(end)
+
+
 def read_samples(folder: Path, samples: str = SAMPLES) -> list[dict]:
     """The complete sample lines of a run (a partial last line is ignored)."""
     path = folder / samples
@@ -81,21 +92,13 @@ class RunStore:
             run_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
         self.done: set[tuple] = set()
         if samples_path.exists():
-            self._cut_partial_line(samples_path)
+            cut_partial_line(samples_path)
             saved = read_samples(folder, samples)
             if keep is not None and len(kept := keep(saved)) != len(saved):
                 _rewrite(samples_path, kept)
                 saved = kept
             self.done = {key(s) for s in saved}
         self._fh = open(samples_path, "a", encoding="utf-8")
-
-    @staticmethod
-    def _cut_partial_line(path: Path) -> None:
-        data = path.read_bytes()
-        end = data.rfind(b"\n") + 1
-        if end != len(data):
-            with open(path, "r+b") as fh:
-                fh.truncate(end)
 
     def append(self, *samples: dict) -> None:
         """Write ``samples`` (one line each) and make them durable together."""

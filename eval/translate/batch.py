@@ -22,6 +22,7 @@ from ara.eval.translate.request_file import FileRequest
 from ara.eval.translate.translator import Translator
 from ara.grammars.spot_bridge import judge
 from ara.provenance import differing
+from ara.run_store import cut_partial_line, read_samples
 
 
 def check_out(out: Path, resume: bool) -> None:
@@ -45,16 +46,8 @@ def done_lines(out: Path, requests: Sequence[FileRequest], model_id: str) -> int
     """
     if not out.exists():
         return 0
-    text = out.read_text(encoding="utf-8")
-    rows, kept = [], 0
-    for line in text.splitlines(keepends=True):
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError:
-            break  # cut off mid-write: the rest is redone
-        kept += len(line)
-    if kept < len(text):
-        out.write_text(text[:kept], encoding="utf-8")
+    cut_partial_line(out)  # cut off mid-write: that answer is made again
+    rows = read_samples(out.parent, out.name)
     if len(rows) > len(requests):
         raise ConfigError(f"{out} has {len(rows)} answers for {len(requests)} requests: "
                           "it is another run's; choose another --out")
