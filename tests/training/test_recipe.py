@@ -369,6 +369,7 @@ def test_a_step_of_several_micro_batches_logs_all_of_them(tiny_gemma_dir, tmp_pa
     assert [x["loss"] for x in log] == [round(v, 5) for v in losses]
 
 
+@pytest.mark.slow  # saving a merged 262k-vocabulary model takes seconds; the export test merges too
 def test_merging_an_adapter_saved_without_a_tokenizer_takes_the_bases(tiny_gemma_dir, tmp_path):
     """A soup of committed adapters has no tokenizer beside it (runs save one, the
     committed records do not): the merged folder gets the base model's, so that
