@@ -3,7 +3,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: setup demo test test-all lint bench lock clean
+.PHONY: setup demo test test-all lint docs bench lock clean
 
 setup:  ## create ./.venv with everything installed (idempotent; seconds when up to date)
 	bash scripts/setup.sh
@@ -19,6 +19,9 @@ test-all: setup  ## every test, slow ones included; prints its 15 slowest tests
 
 lint: setup
 	$(BIN)/ruff check ara grammars data eval training coordination tests bench scripts
+
+docs: setup  ## regenerate docs/cli.md from the commands' --help (the tests check it is current)
+	$(BIN)/python scripts/cli_reference.py
 
 bench: setup  ## measurements, printed as tables; not part of the tests
 	$(BIN)/python bench/spot_bounds.py

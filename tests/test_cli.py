@@ -353,3 +353,12 @@ def test_a_doubted_answer_comes_with_the_other_readings_the_model_weighed():
     assert "or take one of the other readings it weighed:" in note
     assert f"  {data['alternatives'][0]['stl']}  (probability" in note
     assert "other readings" not in ara("translate", *args, "--alternatives", "0").stderr
+
+
+def test_the_command_reference_is_current():
+    """docs/cli.md is generated from the help texts; a changed option fails here until
+    `make docs` rewrites it."""
+    check = subprocess.run([sys.executable, "scripts/cli_reference.py", "--check"],
+                           cwd=Path(__file__).resolve().parents[1], capture_output=True,
+                           text=True, timeout=120)
+    assert check.returncode == 0, check.stderr
