@@ -111,6 +111,10 @@ def grammar_cmd(
     max_bound: int = typer.Option(None, "--max-bound", min=0, show_default=False,
                                   help="Largest time bound in an interval (with --intervals) "
                                        "[default: 1000, what Spot can check]."),
+    bounds: str = typer.Option(
+        None, "--bounds", metavar="N,N,...",
+        help="The only numbers an interval may use (with --intervals); ara translate "
+             "allows 0 and the numbers the sentence writes."),
     allow_inf: bool = typer.Option(False, "--allow-inf",
                                    help="Allow [lo,inf] intervals (with --intervals)."),
     allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),
@@ -128,11 +132,22 @@ def grammar_cmd(
     fmt: GrammarFormat = typer.Option(GrammarFormat.gbnf, "--format", help="Output format."),
 ) -> None:
     """Print the grammar of STL over the given propositions (GBNF for llama.cpp, Lark for
-    outlines/llguidance). The parser accepts exactly the strings this grammar admits."""
+    outlines/llguidance); its strings are exactly those the parser accepts in that layout.
+
+    ara translate decodes a sentence under --intervals --max-depth 5 --max-args 2 with
+    --bounds 0 and the sentence's numbers (none: no --intervals).
+    """
     with user_errors():
-        if not intervals and (allow_inf or max_bound is not None):
-            raise ConfigError("--max-bound and --allow-inf shape intervals: add --intervals")
+        if not intervals and (allow_inf or max_bound is not None or bounds is not None):
+            raise ConfigError("--max-bound, --bounds and --allow-inf shape intervals: "
+                              "add --intervals")
         bound = {} if max_bound is None else {"max_bound": max_bound}
+        if bounds is not None:
+            try:
+                bound["bounds"] = tuple(int(b) for b in split_list(bounds))
+            except ValueError:
+                raise ConfigError(f"--bounds takes whole numbers, e.g. 0,30; got {bounds!r}") \
+                    from None
         syntax = Syntax(aps=split_list(aps), intervals=intervals, **bound,
                         allow_inf=allow_inf, allow_next=allow_next, relaxed=relaxed,
                         max_depth=max_depth, max_args=max_args)

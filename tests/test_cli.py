@@ -83,6 +83,20 @@ def test_grammar_output_loads_in_llama_cpp_and_lark():
     assert checker.accepts("F[2,5](a) & G(!b)") and not checker.accepts("F[2,25](a)")
 
 
+def test_grammar_prints_what_a_sentence_decodes_under():
+    """Tests the help's recipe: `ara grammar` with the sentence's numbers as --bounds and
+    the decoding depth prints the grammar ara translate decodes that sentence under."""
+    from ara.eval.translate.translator import TranslatorConfig
+    from ara.grammars import build_grammar
+
+    nl = "Within 30 steps reach the dock, and never enter the pit."
+    printed = ara("grammar", "--aps", "reach_dock,enter_pit", "--intervals", "--bounds", "0,30",
+                  "--max-depth", "5", "--max-args", "2").stdout
+    used = build_grammar(TranslatorConfig().syntax(("reach_dock", "enter_pit"), nl)).grammar
+    assert printed.split("\n", 1)[1] == used.to_gbnf()
+    assert "ara translate decodes a sentence" in ara("grammar", "--help").stdout
+
+
 def test_grammar_with_bad_propositions_exits_2():
     """Tests that a reserved word as a proposition is refused with the rule."""
     out = ara("grammar", "--aps", "a,F")
@@ -149,6 +163,7 @@ def test_stl_help_gives_the_syntax():
     ("args", "says"),
     [(["grammar", "--aps", "a", "--allow-inf"], "add --intervals"),
      (["grammar", "--aps", "a", "--max-bound", "5"], "add --intervals"),
+     (["grammar", "--aps", "a", "--intervals", "--bounds", "0,ten"], "--bounds takes whole"),
      (["stl", "equiv", "F(a)", "F(b)", "--timeout", "0"], "--timeout"),
      (["eval", "ablation", "--out", "unused", "--shots", "abc"],
       "--shots takes comma-separated whole numbers"),

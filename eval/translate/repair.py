@@ -52,15 +52,15 @@ REPAIR_BY = ("samples+edits", "edits", "samples")
 #: The help of each repair option, shared by ``ara translate``, ``translate-file`` and
 #: ``ara eval ablation``; each command adds its own default for ``samples``.
 REPAIR_HELP = {
-    "samples": "K answers to draw when the first leaves part of the request out (a "
-               "proposition, a stated bound, an order, an 'always' or 'at some point'), "
-               "reads its 'whenever' clause as the consequence, or the model doubts it; "
-               "one with fewer gaps wins.",
+    "samples": "K answers to draw, 0 to 32, when the first leaves part of the request out "
+               "(a proposition, a stated bound, an order, an 'always' or 'at some point'), "
+               "reads its 'whenever' clause as the consequence, or the model doubts it "
+               f"(confidence below {DOUBT}); one with fewer gaps wins. An http(s):// --model "
+               "can neither draw nor score answers: its answer is the first.",
     "by": "samples+edits: the K answers drawn and the formulas one edit from the greedy "
           "answer that close a gap; the one the model scores highest of those with the "
           "fewest gaps wins. edits: the edits alone. samples: the majority of the K drawn "
-          "with the fewest gaps (also what the others do with an HTTP --model, which "
-          "cannot score).",
+          "with the fewest gaps.",
     "doubt": "With repair by samples+edits: also draw the K answers when the greedy answer "
              "leaves nothing out but the model gives it a probability below this, and keep "
              "the best-scored complete one. 0: repair answers with a gap only.",
