@@ -31,7 +31,7 @@ if TYPE_CHECKING:  # the model's modules load on first use
 
 def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
               shots: int | None = None, seed: int = 0, intervals: bool = True,
-              max_bound: int = 1000, any_bound: bool = False, server: str = "openai",
+              max_bound: int = 1000, any_bound: bool = False, server: str = "auto",
               examples_by: str = "random", examples: str | None = None, **how) -> Answer:
     """Translate one instruction into STL over ``aps``, as ``ara translate`` does.
 
@@ -72,7 +72,7 @@ def translate(nl: str, aps: Sequence[str], model: str = "finetuned", *,
 
 
 @lru_cache(maxsize=4)
-def translator(model: str = "finetuned", config=None, server: str = "openai"):
+def translator(model: str = "finetuned", config=None, server: str = "auto"):
     """The :class:`~ara.eval.translate.translator.Translator` for ``model`` and ``config`` (a
     :class:`~ara.eval.translate.translator.TranslatorConfig`), loaded once and kept: loading the
     embedded model takes seconds, a translation a fraction of one. Translators of one

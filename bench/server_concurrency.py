@@ -1,7 +1,7 @@
 """Throughput of constrained translation against an inference server, by the number of
 requests in flight (`ara eval ablation --concurrency N`), measured side by side in one run.
 
-    .venv/bin/python bench/server_concurrency.py [--n 24] [--levels 1,2,4] [--url URL --server vllm]
+    .venv/bin/python bench/server_concurrency.py [--n 24] [--levels 1,2,4] [--url URL]
 
 Without ``--url`` it starts llama-cpp-python's server on loopback with the embedded
 Gemma 3 270M (the shipped adapter is not loaded: the server serves one model file), and
@@ -55,15 +55,17 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=24, help="hand-written instructions")
     ap.add_argument("--levels", default="1,2,4", help="requests in flight, comma list")
     ap.add_argument("--url", help="a running server (default: llama_cpp.server on loopback)")
-    ap.add_argument("--server", default="llama", help="its flavour: llama, vllm or sglang")
+    ap.add_argument("--server", default="auto",
+                    help="its flavour: auto (asked of the server), llama, vllm or sglang")
     args = ap.parse_args()
     records = random.Random(0).sample(load_or_prepare("handwritten").records("test", "grounded"),
                                       args.n)
     url, proc = (args.url, None) if args.url else start_loopback_server()
     try:
-        translator = Translator(OpenAIBackend(url, server=args.server))
+        backend = OpenAIBackend(url, server=args.server)
+        translator = Translator(backend)
         translator.translate(records[0].nl, records[0].aps)  # warm-up
-        print(f"# {args.n} constrained translations against {url} ({args.server}); "
+        print(f"# {args.n} constrained translations against {url} ({backend.server}); "
               f"{platform.machine()}, {os.cpu_count()} cores\n")
         print("| in flight | wall s | formulas/s | vs 1 | valid |\n|---:|---:|---:|---:|---:|")
         base = None

@@ -14,7 +14,7 @@ from ara.data.handwritten import SUITES
 from ara.data.store import FORMS
 from ara.errors import ConfigError
 from ara.eval.translate.answering import BUDGET_S
-from ara.eval.translate.backends.openai_http import GRAMMAR_FIELDS
+from ara.eval.translate.backends.openai_http import SERVERS
 from ara.eval.translate.confidence import DOUBT
 from ara.eval.translate.repair import DEFAULT_REPAIR, REPAIR_BY, REPAIR_HELP
 from ara.eval.translate.repair import TEMPERATURE as REPAIR_TEMPERATURE
@@ -23,7 +23,7 @@ from ara.eval.translate.similar import EXAMPLES_BY as EXAMPLES_BY_VALUES
 # Options with a fixed set of values: the help lists them, and typer refuses others.
 ExamplesBy = Literal[EXAMPLES_BY_VALUES]
 RepairBy = Literal[REPAIR_BY]
-Server = Literal[tuple(GRAMMAR_FIELDS)]
+Server = Literal[SERVERS]
 Form = Literal[FORMS]
 
 eval_app = typer.Typer(
@@ -37,8 +37,9 @@ MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), fine
               "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint "
               "(#NAME after it: the model name sent; #chat:NAME: a chat model)")
 SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
-               "llama, vllm, sglang, or openai (none: constrained decoding is refused, so "
-               "ara translate needs one of the other three).")
+               "auto (asked of the server: llama.cpp, vLLM and SGLang name themselves), "
+               "llama, vllm, sglang, or openai (no grammar: constrained decoding is "
+               "refused, so ara translate needs one of the others).")
 
 
 # The options ``ara translate`` and ``ara translate-file`` share, defined once.
@@ -67,13 +68,17 @@ ANY_BOUND = typer.Option(
 # Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
 TEMPERATURE = typer.Option(REPAIR_TEMPERATURE, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
-                             f"{DEFAULT_REPAIR} (0 where answers are voted); 0: off.")
+                             f"{DEFAULT_REPAIR}; 0: off.")
+# ara eval translate votes and decodes freely, where repair is off by default.
+EVAL_REPAIR_OPTION = typer.Option(
+    None, "--repair", help=REPAIR_HELP["samples"] + f" Default {DEFAULT_REPAIR}, or 0 with "
+    "--samples above 1 or --no-constraint; 0: off.")
 REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["by"])
 DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
     help="Other readings the model weighed to list when it doubts its answer.")
-SERVER = typer.Option("openai", "--server", help=SERVER_HELP)
+SERVER = typer.Option("auto", "--server", help=SERVER_HELP)
 # Checked by AnswerConfig, as the repair options are by RepairConfig.
 BUDGET = typer.Option(
     BUDGET_S, "--budget", metavar="SECONDS",
@@ -136,7 +141,7 @@ def eval_translate_cmd(
         help="Self-consistency: K answers under the grammar (greedy + K-1 sampled), "
              "grouped by Spot equivalence; the largest group wins. 1: greedy."),
     temperature: float = TEMPERATURE,
-    repair: int | None = REPAIR_OPTION,
+    repair: int | None = EVAL_REPAIR_OPTION,
     repair_by: RepairBy = REPAIR_BY_OPTION,
     doubt: float = DOUBT_OPTION,
     alternatives: int = ALTERNATIVES,

@@ -10,7 +10,8 @@
 * ``hf:DIR_OR_ID``: a Hugging Face model through transformers (local folder, or a hub id
   already in the local cache: nothing is downloaded);
 * ``http://...`` or ``https://...``: an OpenAI-compatible endpoint; constrained
-  decoding where ``server`` names a server that reads grammars (llama, vllm, sglang).
+  decoding where the server reads grammars (llama.cpp, vLLM, SGLang: ``server``, which
+  by default asks the server which it is).
   What follows ``#`` is the model name sent (``default`` without one, the name vLLM and
   SGLang serve with ``--served-model-name default``); ``#chat:NAME`` sends the prompt as
   one user message to the chat API, for chat models such as the paper's GPT-4 baseline
@@ -46,7 +47,7 @@ def default_shots(model: str) -> int:
 
 
 def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
-                 server: str = "openai") -> Backend:
+                 server: str = "auto") -> Backend:
     """The backend for a ``--model`` value (see the module doc).
 
     Raises:
@@ -90,7 +91,7 @@ def make_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
 
 
 def shared_backend(model: str, n_ctx: int = 4096, mask: str = "llguidance",
-                   server: str = "openai") -> Backend:
+                   server: str = "auto") -> Backend:
     """:func:`make_backend`'s backend for these arguments, loaded once per process and
     kept (the four most recent; the same arguments by position, by name or left to
     their defaults are one entry): loading the embedded model and an adapter takes

@@ -105,10 +105,24 @@ def test_constrained_requests_to_plain_openai_and_dead_endpoints_are_refused(ser
     """Tests that C needs a server that reads grammars, and that an endpoint nobody
     listens on is an error."""
     with pytest.raises(BackendError, match="--server llama"):
-        Translator(OpenAIBackend(server)).translate("eventually (prop_1)", ["prop_1"])
-    dead = OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5)
+        Translator(OpenAIBackend(server, server="openai")).translate("eventually (prop_1)",
+                                                                     ["prop_1"])
+    dead = OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5, server="llama")
     with pytest.raises(BackendError, match="unreachable"):
         dead.complete("x", None, 4, STOP)
+    with pytest.raises(BackendError, match="unreachable"):  # nobody to ask who it is
+        OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5)
+
+
+def test_a_server_says_which_it_is(server, deaf_server):
+    """Tests --server auto, the default: llama-cpp-python's server and a vLLM each name
+    themselves in their model list, and a constrained translation then goes through
+    without --server."""
+    from ara.eval.translate.models import make_backend
+
+    assert OpenAIBackend(server).server == "llama"
+    assert make_backend(url_of(deaf_server)).server == "vllm"
+    assert Translator(OpenAIBackend(server)).translate("eventually (prop_1)", ["prop_1"]).valid
 
 
 def _decoding_grammar(aps=("prop_1", "prop_2")):
@@ -134,16 +148,43 @@ def test_each_server_gets_the_grammar_in_its_documented_field(flavour, fields):
         OpenAIBackend("http://127.0.0.1:9", server="tgi")
 
 
-@pytest.fixture()
-def deaf_server():
-    """A real HTTP server on loopback that answers like a vLLM which ignores unknown
-    fields: 200 and free text, whatever grammar it was sent; ``.received`` holds each
-    request's path and body."""
+@pytest.mark.parametrize(("listing", "flavour"), [
+    ({"data": [{"id": "gemma", "owned_by": "llamacpp"}]}, "llama"),  # llama.cpp
+    ({"data": [{"id": "gemma", "owned_by": "sglang"}]}, "sglang"),
+    ({"data": [{"id": "gpt-4", "owned_by": "openai"}]}, "openai"),  # says nothing
+    ({"object": "list", "data": []}, "openai"),
+    (None, "openai"),  # no model list at all (HTTP 404)
+])
+def test_a_server_is_known_by_the_name_it_gives_itself(listing, flavour):
+    """Tests what --server auto reads into each answer of GET /v1/models: only a name a
+    server is known to give itself picks its grammar field."""
+    httpd = listing_server(listing)
+    try:
+        assert OpenAIBackend(url_of(httpd)).server == flavour
+    finally:
+        httpd.shutdown()
+
+
+def listing_server(listing: dict | None):
+    """A real HTTP server on loopback, started: GET /v1/models answers ``listing`` (404
+    where it is None); a POST is answered like a vLLM which ignores unknown fields: 200
+    and free text, whatever grammar it was sent. ``.received`` holds each POST's path and
+    body."""
     import json
     import threading
     from http.server import BaseHTTPRequestHandler, HTTPServer
 
     class Handler(BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802 (the stdlib's name)
+            if listing is None or self.path != "/v1/models":
+                self.send_error(404)
+                return
+            body = json.dumps(listing).encode()
+            self.send_response(200)
+            self.send_header("Content-Type", "application/json")
+            self.end_headers()
+            self.wfile.write(body)
+
         def do_POST(self):  # noqa: N802 (the stdlib's name)
             asked = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
             received.append((self.path, asked))
@@ -163,6 +204,13 @@ def deaf_server():
     httpd = HTTPServer(("127.0.0.1", 0), Handler)
     httpd.received = received
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    return httpd
+
+
+@pytest.fixture()
+def deaf_server():
+    """A vLLM that ignores the grammar field (:func:`listing_server`)."""
+    httpd = listing_server({"data": [{"id": "default", "owned_by": "vllm"}]})
     yield httpd
     httpd.shutdown()
 
@@ -198,14 +246,15 @@ def test_the_url_names_the_served_model_and_the_api(deaf_server, suffix, path, n
 
 
 @pytest.mark.skipif(not os.environ.get("ARA_TEST_SERVER_URL"),
-                    reason="set ARA_TEST_SERVER_URL (and ARA_TEST_SERVER=llama|vllm|sglang) "
-                           "to a running server to test it live")
+                    reason="set ARA_TEST_SERVER_URL to a running server to test it live "
+                           "(and ARA_TEST_SERVER=llama|vllm|sglang if it does not say "
+                           "which it is)")
 def test_a_live_server_decodes_under_the_grammar():
     """Tests constrained translation against a server you run (e.g. vLLM with Gemma 3
     12B): the answer is a formula over the request's propositions."""
     backend = OpenAIBackend(os.environ["ARA_TEST_SERVER_URL"],
                             os.environ.get("ARA_TEST_SERVER_MODEL", "default"),
-                            server=os.environ.get("ARA_TEST_SERVER", "llama"))
+                            server=os.environ.get("ARA_TEST_SERVER", "auto"))
     result = Translator(backend).translate("always avoid (prop_1) and eventually reach "
                                            "(prop_2)", ["prop_1", "prop_2"])
     assert result.valid and result.constrained

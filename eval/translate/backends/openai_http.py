@@ -16,6 +16,10 @@ vLLM's and SGLang's grammar backends (xgrammar by default) read as EBNF:
 * ``sglang``: ``"ebnf": GBNF``;
 * ``openai``: no grammar field; a constrained request is refused.
 
+``auto`` (the default) asks the server who it is: llama.cpp's, vLLM's and SGLang's
+servers each name themselves in ``owned_by`` of ``GET /v1/models`` (llama-cpp-python's
+says ``me``); any other answer, OpenAI's own API included, is taken as ``openai``.
+
 A server that ignores the field answers 200 with free text. Every constrained answer
 is therefore checked against the grammar here, and one outside it stops the run with
 an error that says so, never a silent drop in validity.
@@ -35,6 +39,12 @@ from ara.grammars import BuiltGrammar
 #: Where each server flavour reads a grammar; ``openai`` has none.
 GRAMMAR_FIELDS = {"llama": "grammar", "vllm": "structured_outputs.grammar",
                   "sglang": "ebnf", "openai": None}
+#: ``owned_by`` of ``GET /v1/models`` as each server writes it in its source, and the
+#: flavour it means. Only values a server is known to use for itself: OpenAI's API and
+#: proxies answer ``openai``, ``system`` or an organisation, which say nothing.
+OWNED_BY = {"llamacpp": "llama", "me": "llama", "vllm": "vllm", "sglang": "sglang"}
+#: What ``server`` may be: a flavour, or ``auto`` to ask the server.
+SERVERS = ("auto", *GRAMMAR_FIELDS)
 #: What to upgrade or set when a flavour's server ignored the grammar.
 _FIX = {"llama": "a llama.cpp server (any recent build) or llama-cpp-python[server]",
         "vllm": "vLLM >= 0.12 with a structured-outputs backend (xgrammar, guidance)",
@@ -50,7 +60,10 @@ class OpenAIBackend:
         api: ``completions`` or ``chat``.
         timeout_s: Seconds to wait for one answer.
         server: The server's flavour, which says where it reads a grammar
-            (:data:`GRAMMAR_FIELDS`).
+            (:data:`GRAMMAR_FIELDS`), or ``auto``: asked of the server once, here.
+
+    Raises:
+        BackendError: If an argument is unknown, or ``auto`` finds nobody listening.
     """
 
     #: Requests may be in flight at once (``--concurrency``): the server batches them.
@@ -60,21 +73,34 @@ class OpenAIBackend:
     can_sample = False
 
     def __init__(self, base_url: str, model: str = "default", api: str = "completions",
-                 timeout_s: float = 120.0, server: str = "openai") -> None:
+                 timeout_s: float = 120.0, server: str = "auto") -> None:
         if api not in ("completions", "chat"):
             raise BackendError(f"api must be 'completions' or 'chat', got {api!r}")
-        if server not in GRAMMAR_FIELDS:
-            raise BackendError(f"server must be one of {sorted(GRAMMAR_FIELDS)}, got {server!r}")
+        if server not in SERVERS:
+            raise BackendError(f"server must be one of {list(SERVERS)}, got {server!r}")
         self.base_url = base_url.rstrip("/").removesuffix("/v1")
-        self.model, self.api, self.timeout_s, self.server = model, api, timeout_s, server
+        self.model, self.api, self.timeout_s = model, api, timeout_s
+        self.server = self.detect_server() if server == "auto" else server
         self.model_id = f"http:{self.base_url}:{model}"
 
-    def _post(self, path: str, body: dict) -> dict:
+    def detect_server(self) -> str:
+        """The flavour the server names itself as (:data:`OWNED_BY`), else ``openai``."""
+        try:
+            models = self._call("models").get("data") or [{}]
+        except BackendError as err:
+            if not isinstance(err.__cause__, urllib.error.HTTPError):
+                raise  # nobody listening
+            return "openai"  # it answers, but lists no models: a server of another kind
+        return OWNED_BY.get(str(models[0].get("owned_by")), "openai")
+
+    def _call(self, path: str, body: dict | None = None) -> dict:
+        """POST ``body`` to ``/v1/{path}``, or GET it where there is none."""
         headers = {"Content-Type": "application/json"}
         if key := os.environ.get("OPENAI_API_KEY"):
             headers["Authorization"] = f"Bearer {key}"
-        request = urllib.request.Request(f"{self.base_url}/v1/{path}",
-                                         data=json.dumps(body).encode(), headers=headers)
+        request = urllib.request.Request(
+            f"{self.base_url}/v1/{path}", headers=headers,
+            data=None if body is None else json.dumps(body).encode())
         try:
             with urllib.request.urlopen(request, timeout=self.timeout_s) as response:
                 return json.loads(response.read())
@@ -94,11 +120,11 @@ class OpenAIBackend:
                 "stop": [stop], **self.grammar_fields(grammar)}
         start = time.perf_counter()
         if self.api == "chat":
-            answer = self._post("chat/completions",
+            answer = self._call("chat/completions",
                                 {**body, "messages": [{"role": "user", "content": prompt}]})
             text = answer["choices"][0]["message"]["content"]
         else:
-            answer = self._post("completions", {**body, "prompt": prompt})
+            answer = self._call("completions", {**body, "prompt": prompt})
             text = answer["choices"][0]["text"]
         usage = answer.get("usage") or {}
         reason = answer["choices"][0].get("finish_reason")
@@ -116,7 +142,8 @@ class OpenAIBackend:
         where = GRAMMAR_FIELDS[self.server]
         if where is None:
             raise BackendError(
-                "this server is named as plain OpenAI (--server openai, the default), which "
+                f"the server at {self.base_url} is taken as plain OpenAI (it did not name "
+                "itself as llama.cpp, vLLM or SGLang, or --server openai was given), which "
                 "cannot decode under a grammar: name the server that runs it with --server "
                 "llama, vllm or sglang, or use a local model (finetuned, a .gguf path or "
                 "hf:FOLDER)")
