@@ -24,18 +24,19 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
 )
-app.add_typer(stl_app, name="stl")
-app.add_typer(data_app, name="data")
-app.add_typer(eval_app, name="eval")
+app.add_typer(stl_app, name="stl", short_help="Parse, explain and compare formulas.")
+app.add_typer(data_app, name="data", short_help="Prepare, inspect and export data splits.")
+app.add_typer(eval_app, name="eval", short_help="Ablations, scores, diffs, release verdicts.")
 app.add_typer(model_app, name="model")
-app.add_typer(coord_app, name="coord")
-app.command("translate")(translate_cmd)
-app.command("translate-file")(translate_file_cmd)
-app.command("grammar")(grammar_cmd)
-app.command("demo")(demo_cmd)
-app.command("train")(train_cmd)
-app.command("export")(export_cmd)
-app.command("soup")(soup_cmd)
+app.add_typer(coord_app, name="coord", short_help="Help requests, planning, Experiment 2.")
+app.command("translate", short_help="One instruction to STL.")(translate_cmd)
+app.command("translate-file", short_help="A file of instructions to STL (resumable).")(
+    translate_file_cmd)
+app.command("grammar", short_help="Print a decoding grammar (GBNF or Lark).")(grammar_cmd)
+app.command("demo", short_help="The main job on the embedded defaults.")(demo_cmd)
+app.command("train", short_help="LoRA fine-tuning from a recipe config.")(train_cmd)
+app.command("export", short_help="Merge, convert to GGUF, quantize, check.")(export_cmd)
+app.command("soup", short_help="Average the LoRA adapters of runs.")(soup_cmd)
 
 
 def _note(message, category, filename, lineno, file=None, line=None) -> str:

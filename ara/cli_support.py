@@ -12,6 +12,8 @@ import typer
 
 from ara.errors import AraError
 
+#: Exit code for a check's "no" (``ara stl equiv`` of formulas that differ).
+EXIT_NO = 1
 #: Exit code for bad input (invalid formula, unknown option value, missing data).
 EXIT_BAD_INPUT = 2
 #: Exit code for a check that ran out of time (the answer is unknown, not no).

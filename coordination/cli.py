@@ -38,7 +38,7 @@ def _translator(llm: str):
     return Translator(shared_backend(llm))
 
 
-@coord_app.command("exp2")
+@coord_app.command("exp2", short_help="The paper's Experiment 2 and its baselines.")
 def exp2_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder (resumed if it exists)."),
     trials: int = typer.Option(100, "--trials", min=1, help="Number of trials."),
@@ -47,10 +47,11 @@ def exp2_cmd(
                                     help="dp (exact, fast) or milp (the STL->MILP compiler)."),
     llm: str = typer.Option("none", "--model", "--llm", metavar="none|MODEL",
                             help="none: helpers use the template help spec; else a model "
-                                 "(finetuned, finetuned-paper, default, lora:FILE.gguf, "
-                                 "FILE.gguf, hf:DIR or an http(s):// endpoint) that translates "
-                                 "each request (needs --planner milp)."),
-    solver: Solver = typer.Option("highs", "--solver", help="MILP solver: highs or gurobi."),
+                                 "that translates each request, as --model of ara translate "
+                                 "names it (needs --planner milp)."),
+    solver: Solver = typer.Option("highs", "--solver",
+                                  help="MILP solver with --planner milp: highs, or gurobi "
+                                       "(needs gurobipy and a licence)."),
     objective: Objective = typer.Option(
         "paper", "--objective",
         help="What a helper minimizes: paper (path length + when the requester's wait ends + "
@@ -95,13 +96,13 @@ def exp2_cmd(
     typer.echo(f"wrote {out}/trials.csv, summary.json, boxplot.png")
 
 
-@coord_app.command("demo")
+@coord_app.command("demo", short_help="One of the paper's demonstrations.")
 def demo_cmd(
     name: str = typer.Argument(..., metavar="NAME", help="pallet, kitting or tool."),
     out: Path = typer.Option(Path("runs/demos"), "--out", help="Folder for the PNG and JSON."),
     llm: str = typer.Option("none", "--model", "--llm", metavar="none|MODEL",
-                            help="none: the reference STL; else a model that translates "
-                                 "(as --model of ara coord exp2)."),
+                            help="none: the reference STL; else a model that translates, "
+                                 "as --model of ara translate names it."),
 ) -> None:
     """Run one of the paper's demonstrations: messages, STL, plan, and a PNG of the paths."""
     from ara.coordination.demos import DEMOS, run_demo
@@ -112,7 +113,7 @@ def demo_cmd(
         run_demo(name, out, _translator(llm), typer.echo)
 
 
-@coord_app.command("plan")
+@coord_app.command("plan", short_help="Plan one robot's path for an STL spec.")
 def plan_cmd(
     stl: str = typer.Argument(..., metavar="FORMULA",
                               help="A formula over the names given with --at."),

@@ -18,7 +18,7 @@ ROOT_OPT = typer.Option(None, "--root", file_okay=False,
                              "data/prepared].")
 
 
-@data_app.command("prepare")
+@data_app.command("prepare", short_help="Normalize, split and version a data set.")
 def prepare_cmd(
     split: list[str] = typer.Option(
         list(SPLITS), "--split", metavar="SPLIT", show_default=False,
@@ -28,7 +28,9 @@ def prepare_cmd(
              f"{', '.join(SUITES)} (the hand-written suites, test only). Repeat for "
              "several [default: all].",
     ),
-    seed: int = typer.Option(0, "--seed", help="Shuffle seed (timed ignores it)."),
+    seed: int = typer.Option(0, "--seed",
+                             help="Shuffle seed (timed ignores it); ara eval reads seed 0's "
+                                  "splits, a training config its data.seed's."),
     root: Path = ROOT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print the manifests as JSON lines."),
 ) -> None:
@@ -46,7 +48,7 @@ def prepare_cmd(
         ))
 
 
-@data_app.command("stats")
+@data_app.command("stats", short_help="Counts and rejected rows of a split.")
 def stats_cmd(
     split: list[str] = typer.Option(list(SPLITS), "--split", metavar="SPLIT", show_default=False,
                                     help="A split to describe; repeat for several "
@@ -84,7 +86,7 @@ def _cell(value) -> str:
     return f"{value:.1%}" if isinstance(value, float) else str(value)
 
 
-@data_app.command("export")
+@data_app.command("export", short_help="A split as a Hugging Face DatasetDict.")
 def export_cmd(
     out: Path = typer.Option(..., "--out", file_okay=False,
                              help="Folder to write the Hugging Face dataset to."),

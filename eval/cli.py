@@ -27,15 +27,17 @@ Server = Literal[SERVERS]
 Form = Literal[FORMS]
 
 eval_app = typer.Typer(
-    help="Evaluate translators: one translation with every setting, the paper's ablation of "
-         "few-shot examples (F), the grammar in the prompt (P) and constrained decoding (C) "
+    help="Evaluate translators: one translation with every experimental option, the "
+         "paper's ablation of few-shot examples (F), the grammar in the prompt (P) and "
+         "constrained decoding (C) "
          "judged by Spot, and re-scoring, comparing and judging runs.",
     no_args_is_help=True)
 
-MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (with "
-              "the paper split's), default (without), "
-              "lora:ADAPTER.gguf, a .gguf path, hf:FOLDER or an http(s):// endpoint "
-              "(#NAME after it: the model name sent; #chat:NAME: a chat model)")
+MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (the "
+              "same base with a LoRA trained on the paper split alone), default (the base "
+              "model, no LoRA), lora:ADAPTER.gguf (your LoRA on that base), a .gguf path, "
+              "hf:FOLDER or an http(s):// endpoint (#NAME after it: the model name sent; "
+              "#chat:NAME: a chat model)")
 SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
                "auto (asked of the server: llama.cpp, vLLM and SGLang name themselves), "
                "llama, vllm, sglang, or openai (no grammar: constrained decoding is "
@@ -52,7 +54,7 @@ SEED = typer.Option(0, "--seed", help="Which worked examples, and the samples' s
 EXAMPLES_BY = typer.Option(
     "random", "--examples-by",
     help="random (drawn with --seed) or similar (the pool's pairs worded most like the "
-         "request, its propositions' words aside).")
+         "request, leaving the propositions' own words out of the comparison).")
 EXAMPLES = typer.Option(
     None, "--examples", dir_okay=False, exists=True,
     help="Your own pairs to take worked examples from (JSON Lines, each with \"stl\"); "
@@ -64,7 +66,8 @@ MAX_BOUND = typer.Option(1000, "--max-bound", min=1,
                          help="Largest time bound the grammar admits.")
 ANY_BOUND = typer.Option(
     False, "--any-bound",
-    help="Let bounds be any number up to --max-bound, not only 0 and the sentence's own.")
+    help="Let a time bound be any number up to --max-bound; by default only 0 and the "
+         "numbers the sentence writes.")
 # Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
 TEMPERATURE = typer.Option(REPAIR_TEMPERATURE, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
@@ -265,10 +268,11 @@ def translate_file_cmd(
     emit(summary, as_json, lambda s: summary_table(s) + f"\n\nanswers in {out}")
 
 
-eval_app.command("translate")(eval_translate_cmd)
+eval_app.command("translate", short_help="ara translate with every experiment knob.")(
+    eval_translate_cmd)
 
 
-@eval_app.command("ablation")
+@eval_app.command("ablation", short_help="The paper's F/P/C ablation, judged by Spot.")
 def ablation_cmd(
     out: Path = typer.Option(..., "--out", help="Run folder: samples.jsonl, results.json, ..."),
     split: str | None = typer.Option(
@@ -359,7 +363,7 @@ def ablation_cmd(
     typer.echo(f"wrote {out}/samples.jsonl, results.json, tables.md, plot.png")
 
 
-@eval_app.command("score")
+@eval_app.command("score", short_help="Re-score a run from its samples.")
 def score_cmd(
     folder: Path = typer.Argument(..., help="A run folder from `ara eval ablation`."),
     as_json: bool = typer.Option(False, "--json", help="Print results.json instead of tables."),
@@ -372,7 +376,7 @@ def score_cmd(
     emit(results, as_json, tables_markdown)
 
 
-@eval_app.command("diff")
+@eval_app.command("diff", short_help="What one run fixed and broke against another.")
 def diff_cmd(
     before: Path = typer.Argument(..., help="A run folder from `ara eval ablation`."),
     after: Path = typer.Argument(..., help="Another run on the same data (a new model, "
@@ -389,7 +393,7 @@ def diff_cmd(
     emit(result, as_json, lambda d: diff_markdown(d, show))
 
 
-@eval_app.command("verdict")
+@eval_app.command("verdict", short_help="Release gate: may a candidate adapter ship?")
 def verdict_cmd(
     folder: Path = typer.Argument(..., help="A judge's folder (scripts/judge_candidate.sh)."),
     judge: str = typer.Option(..., "--judge", help="The blind suite that judged the change."),
@@ -424,15 +428,15 @@ def _counts(text: str, option: str) -> tuple[int, ...]:
                           f"got {text!r}") from None
 
 
-@eval_app.command("ceiling")
+@eval_app.command("ceiling", short_help="The accuracy a split's own labels allow.")
 def ceiling_cmd(
     split: str = typer.Option("paper", "--split",
                               help="paper, disjoint, timed, compositional or a hand-written "
                                    "suite (handwritten, handwritten2, ...)."),
     form: Form = typer.Option("lifted", "--form", help="lifted or grounded."),
     limit: int = typer.Option(0, "--limit", min=0,
-                              help="Measure the sample an ablation with this --limit and "
-                                   "--seed scores (0: the whole test side)."),
+                              help="Measure only the N test pairs `ara eval ablation --limit N "
+                                   "--seed S` samples (0: the whole test side)."),
     seed: int = typer.Option(0, "--seed", help="Seed of that sample."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:

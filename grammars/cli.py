@@ -6,7 +6,7 @@ from enum import Enum
 
 import typer
 
-from ara.cli_support import emit, split_list, user_errors
+from ara.cli_support import EXIT_NO, emit, split_list, user_errors
 from ara.errors import ConfigError
 from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
@@ -33,7 +33,7 @@ TIMEOUT_OPT = typer.Option(
 )
 
 
-@stl_app.command("parse")
+@stl_app.command("parse", short_help="Print a formula in canonical form.")
 def parse_cmd(
     formula: str = typer.Argument(..., metavar="FORMULA",
                                   help="A formula, e.g. 'F(a) & G[0,30](!b)'."),
@@ -48,7 +48,7 @@ def parse_cmd(
     emit({"stl": to_text(tree), "valid": True}, as_json, lambda v: v["stl"])
 
 
-@stl_app.command("explain")
+@stl_app.command("explain", short_help="Read a formula back in plain English.")
 def explain_cmd(
     formula: str = typer.Argument(..., metavar="FORMULA",
                                   help="A formula, e.g. 'G(door_open -> F[0,5](close))'."),
@@ -62,28 +62,34 @@ def explain_cmd(
     emit({"stl": to_text(tree), "english": explain(tree)}, as_json, lambda v: v["english"])
 
 
-@stl_app.command("equiv")
+@stl_app.command("equiv", short_help="Whether A and B are equivalent (Spot).")
 def equiv_cmd(
     a: str = typer.Argument(..., metavar="A", help="First formula."),
     b: str = typer.Argument(..., metavar="B", help="Second formula."),
     as_json: bool = JSON_OPT,
     timeout: float = TIMEOUT_OPT,
 ) -> None:
-    """Whether A and B hold on exactly the same traces (decided by Spot)."""
+    """Whether A and B hold on exactly the same traces (decided by Spot).
+
+    Exit 0: equivalent; 1: not; 2: a formula does not parse; 3: undecided in --timeout.
+    """
     from ara.grammars.spot_bridge import equivalent
 
     _spot_verdict(equivalent, a, b, as_json, timeout, "equivalent",
                   ("equivalent", "not equivalent"))
 
 
-@stl_app.command("implies")
+@stl_app.command("implies", short_help="Whether A implies B (Spot).")
 def implies_cmd(
     a: str = typer.Argument(..., metavar="A", help="Premise."),
     b: str = typer.Argument(..., metavar="B", help="Conclusion."),
     as_json: bool = JSON_OPT,
     timeout: float = TIMEOUT_OPT,
 ) -> None:
-    """Whether A implies B: every trace satisfying A satisfies B (decided by Spot)."""
+    """Whether A implies B: every trace satisfying A satisfies B (decided by Spot).
+
+    Exit 0: it does; 1: it does not; 2: a formula does not parse; 3: undecided in --timeout.
+    """
     from ara.grammars.spot_bridge import implies
 
     _spot_verdict(implies, a, b, as_json, timeout, "implies",
@@ -92,10 +98,13 @@ def implies_cmd(
 
 def _spot_verdict(decide, a: str, b: str, as_json: bool, timeout: float, key: str,
                   words: tuple[str, str]) -> None:
-    """Parse both formulas, ask Spot, print ``{key: verdict}`` or the verdict's words."""
+    """Parse both formulas, ask Spot, print ``{key: verdict}`` or the verdict's words, and
+    exit 1 for no, as diff and grep do, so a script can branch on the code alone."""
     with user_errors():
         result = decide(parse(a), parse(b), timeout_s=timeout)
     emit({key: result}, as_json, lambda v: words[0] if result else words[1])
+    if not result:
+        raise typer.Exit(EXIT_NO)
 
 
 class GrammarFormat(str, Enum):

@@ -54,9 +54,9 @@ def test_invalid_formula_exits_2_naming_the_position():
     ],
 )
 def test_equiv_and_implies_print_one_json_object(command, a, b, key, expected):
-    """Tests `ara stl equiv|implies A B --json`."""
+    """Tests `ara stl equiv|implies A B --json`, and its exit code, 1 for no."""
     out = ara("stl", command, a, b, "--json")
-    assert out.returncode == 0 and json.loads(out.stdout) == {key: expected}
+    assert out.returncode == (0 if expected else 1) and json.loads(out.stdout) == {key: expected}
 
 
 def test_a_check_past_its_time_limit_exits_3():
@@ -377,3 +377,23 @@ def test_the_command_reference_is_current():
                            cwd=Path(__file__).resolve().parents[1], capture_output=True,
                            text=True, timeout=120)
     assert check.returncode == 0, check.stderr
+
+
+def test_every_command_lists_with_a_whole_summary():
+    """Tests the Commands lists of `ara --help` and each group's: each summary is whole,
+    not a first sentence cut at click's 45 characters."""
+    import typer
+    from click import Group
+
+    def commands(group, ctx):
+        for name in group.list_commands(ctx):
+            command = group.get_command(ctx, name)
+            yield name, command
+            if isinstance(command, Group):
+                yield from commands(command, ctx)
+
+    root = typer.main.get_command(app)
+    with typer.Context(root) as ctx:
+        cut = [name for name, command in commands(root, ctx)
+               if command.get_short_help_str(limit=45).endswith("...")]
+    assert not cut

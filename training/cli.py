@@ -13,7 +13,7 @@ from ara.training.export import PARITY_PAIRS
 model_app = typer.Typer(help="Prepare base models (no downloads).", no_args_is_help=True)
 
 
-@model_app.command("prepare")
+@model_app.command("prepare", short_help="The embedded GGUF as a local HF folder.")
 def prepare_cmd(
     out: Path = typer.Option(None, "--out",
                              help="The folder to write, new or an earlier conversion (it "
@@ -36,8 +36,8 @@ def train_cmd(
                                      "`stages:`), e.g. training/configs/gemma3_270m_nl2tl.yaml."),
     max_steps: int = typer.Option(
         None, "--max-steps", min=1,
-        help="Stop after N optimizer steps (in a recipe: each training stage at most N, a "
-             "smoke run whose stages a run without the flag trains again)."),
+        help="Stop after N optimizer steps, for a smoke run (in a recipe: each training "
+             "stage; a later run without the flag trains those stages again)."),
     resume: bool = typer.Option(
         False, "--resume",
         help="Continue a single run from its newest checkpoint (a recipe always goes on "
@@ -50,10 +50,11 @@ def train_cmd(
 ) -> None:
     """LoRA fine-tuning (transformers + peft + accelerate) with the eval prompt format.
 
-    A staged recipe runs its stages in order (train, soup, export), each into OUT/NAME;
+    A staged recipe runs its stages in order (train, soup, export), each into a folder
+    named after it under the recipe's `out:`;
     rerun the same command to go on after an interruption: done stages are skipped, an
     interrupted one resumes, and a stage whose settings changed is rebuilt with the
-    stages after it. OUT/recipe.json records each stage's wall time and peak memory.
+    stages after it. recipe.json there records each stage's wall time and peak memory.
     """
     import json
     import signal
@@ -134,7 +135,8 @@ def soup_cmd(
              "higher rank is slower at every token). With --rank, one --run is enough: "
              "that run's adapter, reduced."),
 ) -> None:
-    """Average the adapters of runs that grew from one start into one exact LoRA adapter.
+    """Average the LoRA adapters of runs trained from one starting point, exactly: the
+    result is one LoRA adapter whose rank is the sum of theirs (see --rank).
 
     The result is a run folder like any other: `ara export --run OUT --lora-gguf` turns
     it into a GGUF LoRA for `ara translate --model lora:OUT/export/lora.gguf`.
