@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
 import typer
 
 from ara.cli_support import emit, user_errors
 from ara.data.handwritten import SUITES
-from ara.data.store import SPLITS, load_or_prepare, prepare, to_hf
+from ara.data.store import FORMS, SPLITS, load_or_prepare, prepare, to_hf
 
 data_app = typer.Typer(help="Prepare, inspect and export the versioned NL2TL splits.",
                        no_args_is_help=True)
@@ -92,7 +93,7 @@ def export_cmd(
                              help="Folder to write the Hugging Face dataset to."),
     split: str = typer.Option("paper", "--split", help="Split to export."),
     seed: int = typer.Option(0, "--seed", help="Seed it was prepared with."),
-    form: str = typer.Option(None, "--form",
+    form: Literal[FORMS] | None = typer.Option(None, "--form",
                              help="lifted (placeholder names prop_1, prop_2, ...) or grounded "
                                   "(the sentence's own names) [default: both]."),
     root: Path = ROOT_OPT,

@@ -314,7 +314,8 @@ def ablation_cmd(
     spot_timeout: float = typer.Option(10.0, "--spot-timeout", min=0.1,
                                        help="Seconds per Spot check before 'undecided'."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run in --out."),
-    no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Show a progress bar on stderr."),
     server: Server = SERVER,
     concurrency: int = typer.Option(
         1, "--concurrency", min=1,
@@ -353,7 +354,7 @@ def ablation_cmd(
         plan(config, loaded)  # a bad file or plan is named before the model loads
         backend = make_backend(model, mask=mask, server=server)
         try:
-            results = run_ablation(config, backend, out, resume, progress=not no_progress,
+            results = run_ablation(config, backend, out, resume, progress=progress,
                                    concurrency=concurrency, split=loaded)
         except KeyboardInterrupt:
             typer.echo(f"interrupted: finished samples are in {out}; continue with --resume",
