@@ -27,7 +27,7 @@ app = typer.Typer(
 app.add_typer(stl_app, name="stl", short_help="Parse, explain and compare formulas.")
 app.add_typer(data_app, name="data", short_help="Prepare, inspect and export data splits.")
 app.add_typer(eval_app, name="eval", short_help="Ablations, scores, diffs, release verdicts.")
-app.add_typer(model_app, name="model")
+app.add_typer(model_app, name="model", short_help="Prepare base models (no downloads).")
 app.add_typer(coord_app, name="coord", short_help="Help requests, planning, Experiment 2.")
 app.command("translate", short_help="One instruction to STL.")(translate_cmd)
 app.command("translate-file", short_help="A file of instructions to STL (resumable).")(

@@ -15,6 +15,8 @@ from itertools import pairwise
 
 import typer
 
+from ara.eval.cli import SERVER, Server
+
 
 def demo_cmd(
     n: int = typer.Option(4, "--n", min=1, max=20, help="How many test pairs to show."),
@@ -25,17 +27,18 @@ def demo_cmd(
     shots: int = typer.Option(None, "--shots", min=0, max=50,
                               help="Worked examples in the prompt [default: 0 for the "
                                    "fine-tune, which needs none; 5 otherwise]."),
+    server: Server = SERVER,
 ) -> None:
     """Prepare the data, show grammar, parse and Spot checks, and translate a few pairs."""
     from ara.cli_support import user_errors
     from ara.eval.translate.models import shared_backend
 
     with user_errors():
-        shared_backend(model)  # a --model that names none is refused before the long part
-        _demo(n, seed, model, shots)
+        shared_backend(model, server=server)  # a bad --model is refused before the long part
+        _demo(n, seed, model, shots, server)
 
 
-def _demo(n: int, seed: int, model: str, shots: int | None) -> None:
+def _demo(n: int, seed: int, model: str, shots: int | None, server: str) -> None:
     import lark
 
     from ara.data import SPLITS, prepare
@@ -76,7 +79,7 @@ def _demo(n: int, seed: int, model: str, shots: int | None) -> None:
         from ara.eval.translate.models import default_shots
 
         shots = default_shots(model)
-    translator = _translate_some(model, n, seed, shots)
+    translator = _translate_some(model, n, seed, shots, server)
     _help_round(translator)
 
 
@@ -90,7 +93,7 @@ def _help_round(translator) -> None:
              lambda line: typer.echo(f"  {line}"))
 
 
-def _translate_some(model: str, n: int, seed: int, k: int):
+def _translate_some(model: str, n: int, seed: int, k: int, server: str):
     from ara.data import prepare
     from ara.eval.translate.models import shared_backend
     from ara.eval.translate.prompt import sample_shots
@@ -100,7 +103,7 @@ def _translate_some(model: str, n: int, seed: int, k: int):
     rng = random.Random(seed)
     pool = prepare("compositional", 0).records("train", "grounded")
     shots = sample_shots(pool, k, rng) if k else []
-    translator = Translator(shared_backend(model))
+    translator = Translator(shared_backend(model, server=server))
     typer.echo(f"\n== translate: hand-written sentences no model trained on; "
                f"{translator.backend.model_id}, {k} shots, grammar-constrained")
     for r in rng.sample(prepare("handwritten", 0).records("test", "grounded"), n):

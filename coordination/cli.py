@@ -15,6 +15,7 @@ from ara.coordination.planner_dp import OBJECTIVES
 from ara.coordination.protocol import PLANNERS
 from ara.coordination.trials import INSTANCES
 from ara.errors import ConfigError
+from ara.eval.cli import SERVER, Server
 
 # Options with a fixed set of values: the help lists them, and typer refuses others.
 Planner = Literal[PLANNERS]
@@ -28,14 +29,14 @@ coord_app = typer.Typer(help="Multi-robot help requests: Experiment 2, demos, pl
                         no_args_is_help=True)
 
 
-def _translator(llm: str):
+def _translator(llm: str, server: str):
     """None for --model none; else the eval translator over that model."""
     if llm == "none":
         return None
     from ara.eval.translate.models import shared_backend
     from ara.eval.translate.translator import Translator
 
-    return Translator(shared_backend(llm))
+    return Translator(shared_backend(llm, server=server))
 
 
 @coord_app.command("exp2", short_help="The paper's Experiment 2 and its baselines.")
@@ -77,6 +78,7 @@ def exp2_cmd(
     processes: int = typer.Option(1, "--processes", min=1,
                                   help="Trials run in parallel (joblib processes); with "
                                        "--model, one at a time, over the one loaded model."),
+    server: Server = SERVER,
 ) -> None:
     """Reproduce the paper's Experiment 2: trials.csv, summary.json, boxplot.png in OUT."""
     from ara.coordination.experiment2 import Exp2Config, run, table
@@ -89,7 +91,7 @@ def exp2_cmd(
             from ara.coordination.milp import make_solver
 
             make_solver(solver)  # fails now, with its reason, rather than in a worker
-        factory = (lambda: _translator(llm)) if llm != "none" else None
+        factory = (lambda: _translator(llm, server)) if llm != "none" else None
         summary = run(config, out, processes, factory)
     typer.echo(table(summary))
     typer.echo(json.dumps(summary["comparisons"], indent=2))
@@ -103,6 +105,7 @@ def demo_cmd(
     llm: str = typer.Option("none", "--model", "--llm", metavar="none|MODEL",
                             help="none: the reference STL; else a model that translates, "
                                  "as --model of ara translate names it."),
+    server: Server = SERVER,
 ) -> None:
     """Run one of the paper's demonstrations: messages, STL, plan, and a PNG of the paths."""
     from ara.coordination.demos import DEMOS, run_demo
@@ -110,7 +113,7 @@ def demo_cmd(
     with user_errors():
         if name not in DEMOS:  # before a model loads
             raise ConfigError(f"unknown demo {name!r}: choose one of {', '.join(DEMOS)}")
-        run_demo(name, out, _translator(llm), typer.echo)
+        run_demo(name, out, _translator(llm, server), typer.echo)
 
 
 @coord_app.command("plan", short_help="Plan one robot's path for an STL spec.")

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import traceback
 from enum import Enum
 
 import typer
 
-from ara.cli_support import EXIT_NO, emit, split_list, user_errors
-from ara.errors import ConfigError
+from ara.cli_support import EXIT_BAD_INPUT, EXIT_NO, emit, split_list, user_errors
+from ara.errors import AraError, ConfigError
 from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
 from ara.grammars.stl_grammar import build_grammar
@@ -71,7 +72,7 @@ def equiv_cmd(
 ) -> None:
     """Whether A and B hold on exactly the same traces (decided by Spot).
 
-    Exit 0: equivalent; 1: not; 2: a formula does not parse; 3: undecided in --timeout.
+    Exit 0: equivalent; 1: not; 2: bad input or Spot failed; 3: undecided in --timeout.
     """
     from ara.grammars.spot_bridge import equivalent
 
@@ -88,7 +89,7 @@ def implies_cmd(
 ) -> None:
     """Whether A implies B: every trace satisfying A satisfies B (decided by Spot).
 
-    Exit 0: it does; 1: it does not; 2: a formula does not parse; 3: undecided in --timeout.
+    Exit 0: it does; 1: it does not; 2: bad input or Spot failed; 3: undecided in --timeout.
     """
     from ara.grammars.spot_bridge import implies
 
@@ -101,7 +102,13 @@ def _spot_verdict(decide, a: str, b: str, as_json: bool, timeout: float, key: st
     """Parse both formulas, ask Spot, print ``{key: verdict}`` or the verdict's words, and
     exit 1 for no, as diff and grep do, so a script can branch on the code alone."""
     with user_errors():
-        result = decide(parse(a), parse(b), timeout_s=timeout)
+        try:
+            result = decide(parse(a), parse(b), timeout_s=timeout)
+        except (AraError, OSError, TimeoutError):
+            raise
+        except Exception:  # a crash exits 1 too, which would read as "no"
+            traceback.print_exc()
+            raise typer.Exit(EXIT_BAD_INPUT) from None
     emit({key: result}, as_json, lambda v: words[0] if result else words[1])
     if not result:
         raise typer.Exit(EXIT_NO)
@@ -143,8 +150,9 @@ def grammar_cmd(
     """Print the grammar of STL over the given propositions (GBNF for llama.cpp, Lark for
     outlines/llguidance); its strings are exactly those the parser accepts in that layout.
 
-    ara translate decodes a sentence under --intervals --max-depth 5 --max-args 2 with
-    --bounds 0 and the sentence's numbers (none: no --intervals).
+    The formulas ara translate decodes a sentence into are this grammar's with
+    --intervals --max-depth 5 --max-args 2 --bounds 0 and the sentence's numbers (a
+    sentence with none: no --intervals).
     """
     with user_errors():
         if not intervals and (allow_inf or max_bound is not None or bounds is not None):

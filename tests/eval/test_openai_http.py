@@ -110,19 +110,11 @@ def test_constrained_requests_to_plain_openai_and_dead_endpoints_are_refused(ser
     dead = OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5, server="llama")
     with pytest.raises(BackendError, match="unreachable"):
         dead.complete("x", None, 4, STOP)
-    with pytest.raises(BackendError, match="unreachable"):  # nobody to ask who it is
-        OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5)
 
 
-def test_a_server_says_which_it_is(server, deaf_server):
-    """Tests --server auto, the default: llama-cpp-python's server and a vLLM each name
-    themselves in their model list, and a constrained translation then goes through
-    without --server."""
-    from ara.eval.translate.models import make_backend
-
+def test_llama_cpp_python_says_which_server_it_is(server):
+    """Tests --server auto, the default, against the real llama-cpp-python server."""
     assert OpenAIBackend(server).server == "llama"
-    assert make_backend(url_of(deaf_server)).server == "vllm"
-    assert Translator(OpenAIBackend(server)).translate("eventually (prop_1)", ["prop_1"]).valid
 
 
 def _decoding_grammar(aps=("prop_1", "prop_2")):
@@ -150,14 +142,18 @@ def test_each_server_gets_the_grammar_in_its_documented_field(flavour, fields):
 
 @pytest.mark.parametrize(("listing", "flavour"), [
     ({"data": [{"id": "gemma", "owned_by": "llamacpp"}]}, "llama"),  # llama.cpp
+    ({"data": [{"id": "gemma", "owned_by": "vllm"}]}, "vllm"),
     ({"data": [{"id": "gemma", "owned_by": "sglang"}]}, "sglang"),
     ({"data": [{"id": "gpt-4", "owned_by": "openai"}]}, "openai"),  # says nothing
     ({"object": "list", "data": []}, "openai"),
-    (None, "openai"),  # no model list at all (HTTP 404)
+    ({"data": {"id": "x"}}, "openai"), ({"data": ["x"]}, "openai"), ([1], "openai"),
+    ({"data": [{"owned_by": ["vllm"]}]}, "openai"),
+    (404, "openai"), (501, "openai"),  # no model list at all
 ])
 def test_a_server_is_known_by_the_name_it_gives_itself(listing, flavour):
     """Tests what --server auto reads into each answer of GET /v1/models: only a name a
-    server is known to give itself picks its grammar field."""
+    server is known to give itself picks its grammar field; a listing of another shape
+    means plain OpenAI."""
     httpd = listing_server(listing)
     try:
         assert OpenAIBackend(url_of(httpd)).server == flavour
@@ -165,21 +161,40 @@ def test_a_server_is_known_by_the_name_it_gives_itself(listing, flavour):
         httpd.shutdown()
 
 
-def listing_server(listing: dict | None):
-    """A real HTTP server on loopback, started: GET /v1/models answers ``listing`` (404
-    where it is None); a POST is answered like a vLLM which ignores unknown fields: 200
-    and free text, whatever grammar it was sent. ``.received`` holds each POST's path and
-    body."""
+@pytest.mark.parametrize(("listing", "says"), [
+    (401, "set \\$OPENAI_API_KEY"), (403, "set \\$OPENAI_API_KEY"),
+    (503, "(?s)HTTP 503.*name the server with --server"),  # llama-server still loading
+    (b"<html>log in</html>", "did not answer as an OpenAI-compatible server"),
+])
+def test_a_server_that_will_not_say_which_it_is_is_an_error_that_says_what_to_do(listing,
+                                                                                  says):
+    """Tests --server auto where the answer cannot be read: an error naming the fix, never
+    a silent guess that would refuse every constrained request later."""
+    httpd = listing_server(listing)
+    try:
+        with pytest.raises(BackendError, match=says):
+            OpenAIBackend(url_of(httpd))
+    finally:
+        httpd.shutdown()
+    with pytest.raises(BackendError, match="unreachable"):  # nobody to ask
+        OpenAIBackend(f"http://127.0.0.1:{free_port()}", timeout_s=5)
+
+
+def listing_server(listing):
+    """A real HTTP server on loopback, started: GET /v1/models answers ``listing`` (JSON, or
+    those bytes, or an int: that HTTP error); a POST is answered like a vLLM which ignores
+    unknown fields: 200 and free text, whatever grammar it was sent. ``.received`` holds
+    each POST's path and body."""
     import json
     import threading
     from http.server import BaseHTTPRequestHandler, HTTPServer
 
     class Handler(BaseHTTPRequestHandler):
         def do_GET(self):  # noqa: N802 (the stdlib's name)
-            if listing is None or self.path != "/v1/models":
-                self.send_error(404)
+            if isinstance(listing, int) or self.path != "/v1/models":
+                self.send_error(listing if isinstance(listing, int) else 404)
                 return
-            body = json.dumps(listing).encode()
+            body = listing if isinstance(listing, bytes) else json.dumps(listing).encode()
             self.send_response(200)
             self.send_header("Content-Type", "application/json")
             self.end_headers()

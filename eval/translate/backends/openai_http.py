@@ -27,6 +27,7 @@ an error that says so, never a silent drop in validity.
 
 from __future__ import annotations
 
+import http.client
 import json
 import os
 import time
@@ -45,6 +46,8 @@ GRAMMAR_FIELDS = {"llama": "grammar", "vllm": "structured_outputs.grammar",
 OWNED_BY = {"llamacpp": "llama", "me": "llama", "vllm": "vllm", "sglang": "sglang"}
 #: What ``server`` may be: a flavour, or ``auto`` to ask the server.
 SERVERS = ("auto", *GRAMMAR_FIELDS)
+#: Seconds to wait for the server to say which it is (a firewalled host never answers).
+PROBE_S = 10.0
 #: What to upgrade or set when a flavour's server ignored the grammar.
 _FIX = {"llama": "a llama.cpp server (any recent build) or llama-cpp-python[server]",
         "vllm": "vLLM >= 0.12 with a structured-outputs backend (xgrammar, guidance)",
@@ -86,15 +89,26 @@ class OpenAIBackend:
     def detect_server(self) -> str:
         """The flavour the server names itself as (:data:`OWNED_BY`), else ``openai``."""
         try:
-            models = self._call("models").get("data") or [{}]
+            listing = self._call("models", timeout_s=min(self.timeout_s, PROBE_S))
         except BackendError as err:
-            if not isinstance(err.__cause__, urllib.error.HTTPError):
-                raise  # nobody listening
-            return "openai"  # it answers, but lists no models: a server of another kind
-        return OWNED_BY.get(str(models[0].get("owned_by")), "openai")
+            code = getattr(err.__cause__, "code", None)
+            if code in (404, 405, 501):
+                return "openai"  # it answers, but lists no models: a server of another kind
+            if code in (401, 403):
+                raise BackendError(
+                    f"{self.base_url} refused to say which server it is (HTTP {code}): set "
+                    "$OPENAI_API_KEY to its key, or name the server with --server") from err
+            raise BackendError(f"{err}; or name the server with --server, which skips "
+                               "asking it") from err
+        models = listing.get("data") if isinstance(listing, dict) else None
+        first = models[0] if isinstance(models, list) and models else None
+        return OWNED_BY.get(str(first.get("owned_by")), "openai") if isinstance(first, dict) \
+            else "openai"
 
-    def _call(self, path: str, body: dict | None = None) -> dict:
-        """POST ``body`` to ``/v1/{path}``, or GET it where there is none."""
+    def _call(self, path: str, body: dict | None = None,
+              timeout_s: float | None = None) -> dict:
+        """POST ``body`` to ``/v1/{path}``, or GET it where there is none; the answer's
+        JSON."""
         headers = {"Content-Type": "application/json"}
         if key := os.environ.get("OPENAI_API_KEY"):
             headers["Authorization"] = f"Bearer {key}"
@@ -102,7 +116,7 @@ class OpenAIBackend:
             f"{self.base_url}/v1/{path}", headers=headers,
             data=None if body is None else json.dumps(body).encode())
         try:
-            with urllib.request.urlopen(request, timeout=self.timeout_s) as response:
+            with urllib.request.urlopen(request, timeout=timeout_s or self.timeout_s) as response:
                 return json.loads(response.read())
         except urllib.error.HTTPError as err:
             detail = err.read().decode(errors="replace")[:300]
@@ -111,6 +125,9 @@ class OpenAIBackend:
             raise BackendError(
                 f"endpoint {self.base_url} is unreachable ({err}); is the server running?"
             ) from err
+        except (ValueError, http.client.HTTPException) as err:  # not JSON, or not HTTP
+            raise BackendError(f"{self.base_url}/v1/{path} did not answer as an "
+                               f"OpenAI-compatible server does: {err}") from err
 
     def complete(self, prompt: str, grammar: BuiltGrammar | None, max_tokens: int,
                  stop: str, sampling: Sampling | None = None) -> Completion:
