@@ -121,7 +121,8 @@ def plan_cmd(
     stl: str = typer.Argument(..., metavar="FORMULA",
                               help="A formula over the names given with --at."),
     at: list[str] = typer.Option(..., "--at", metavar="NAME=ROW,COL",
-                                 help="Where each event is, repeated for each."),
+                                 help="The grid cell of each proposition of FORMULA, "
+                                      "repeated: --at a=0,7 --at b=7,7."),
     start: str = typer.Option("0,0", "--start", metavar="ROW,COL",
                               help="Where the robot starts."),
     world_file: Path = typer.Option(
@@ -129,8 +130,10 @@ def plan_cmd(
         help="Grid file: one line a row, '.' free, '#' obstacle [default: the paper's 8x8]."),
     objective: Objective = typer.Option(
         "makespan", "--objective", help="makespan, paper or authors (as ara coord exp2's)."),
-    cap: int = typer.Option(None, "--cap", min=0, help="Largest makespan allowed."),
-    solver: Solver = typer.Option("highs", "--solver", help="highs or gurobi."),
+    cap: int = typer.Option(None, "--cap", min=0,
+                            help="Largest makespan allowed, in time steps (one grid move each)."),
+    solver: Solver = typer.Option("highs", "--solver",
+                                  help="highs, or gurobi (needs gurobipy and a licence)."),
     as_json: bool = typer.Option(False, "--json", help="One JSON object."),
 ) -> None:
     """Plan a robot's path for an STL spec with the event MILP (no plan: exit 1)."""

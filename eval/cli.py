@@ -399,7 +399,8 @@ def verdict_cmd(
     folder: Path = typer.Argument(..., help="A judge's folder (scripts/judge_candidate.sh)."),
     judge: str = typer.Option(..., "--judge", help="The blind suite that judged the change."),
     max_drop: float = typer.Option(1.0, "--max-drop",
-                                   help="Points any other set may fall below the shipped file."),
+                                   help="Percentage points any other held-out set may fall "
+                                        "below the shipped file."),
     help_misses: int = typer.Option(0, "--help-misses",
                                     help="Help requests the candidate may get wrong beyond "
                                          "the shipped file's."),

@@ -22,7 +22,8 @@ def prepare_cmd(
     gguf: str = typer.Option(None, "--gguf", help="GGUF to convert [default: embedded 270M]."),
     force: bool = typer.Option(False, "--force", help="Convert again even if done."),
 ) -> None:
-    """Convert the embedded Gemma 3 270M GGUF into a local HF folder, once (~2 min)."""
+    """Convert the embedded Gemma 3 270M GGUF into a local HF folder, once (~2 min): what
+    hf: models and ara train load (ara train converts it itself when it is missing)."""
     from ara.training.hf_model import prepare_base_model
 
     with user_errors():
@@ -159,7 +160,8 @@ def export_cmd(
     parity_pairs: int = typer.Option(PARITY_PAIRS, "--parity",
                                      help="Test pairs for the GGUF vs HF greedy check (0: skip)."),
 ) -> None:
-    """Merge the adapter into the base, convert to GGUF, quantize, check parity."""
+    """Merge the adapter into the base, convert to GGUF, quantize and check parity, into
+    RUN/export/. The converter is llama.cpp's, from PyPI, fetched on first use."""
     import json
 
     from ara.cli_support import split_list
