@@ -33,15 +33,12 @@ eval_app = typer.Typer(
          "judged by Spot, and re-scoring, comparing and judging runs.",
     no_args_is_help=True)
 
-MODEL_HELP = ("finetuned (the embedded Gemma 3 270M with its shipped LoRA), finetuned-paper (the "
-              "same base with a LoRA trained on the paper split alone), default (the base "
-              "model, no LoRA), lora:ADAPTER.gguf (your LoRA on that base), a .gguf path, "
-              "hf:FOLDER or an http(s):// endpoint (#NAME after it: the model name sent; "
+MODEL_HELP = ("finetuned (the embedded Gemma 3 270M + its shipped LoRA), finetuned-paper (+ a "
+              "LoRA of the paper split), default (no LoRA), lora:ADAPTER.gguf (yours), a "
+              ".gguf path, hf:FOLDER or an http(s):// endpoint (#NAME: the model name sent; "
               "#chat:NAME: a chat model)")
-SERVER_HELP = ("The server behind an http(s):// --model, which says how it takes a grammar: "
-               "auto (asked of the server: llama.cpp, vLLM and SGLang name themselves), "
-               "llama, vllm, sglang, or openai (no grammar: constrained decoding is "
-               "refused, so ara translate needs one of the others).")
+SERVER_HELP = ("The server behind an http(s):// --model, which says where it reads a "
+               "grammar: auto (asks it), or llama, vllm, sglang, openai (none).")
 
 
 # The options ``ara translate`` and ``ara translate-file`` share, defined once.
@@ -54,7 +51,7 @@ SEED = typer.Option(0, "--seed", help="Which worked examples, and the samples' s
 EXAMPLES_BY = typer.Option(
     "random", "--examples-by",
     help="random (drawn with --seed) or similar (the pool's pairs worded most like the "
-         "request, leaving the propositions' own words out of the comparison).")
+         "request, propositions aside).")
 EXAMPLES = typer.Option(
     None, "--examples", dir_okay=False, exists=True,
     help="Your own pairs to take worked examples from (JSON Lines, each with \"stl\"); "
@@ -66,8 +63,7 @@ MAX_BOUND = typer.Option(1000, "--max-bound", min=1,
                          help="Largest time bound the grammar admits.")
 ANY_BOUND = typer.Option(
     False, "--any-bound",
-    help="Let a time bound be any number up to --max-bound; by default only 0 and the "
-         "numbers the sentence writes.")
+    help="Bounds up to --max-bound, not only 0 and the numbers the sentence writes.")
 # Ranges are checked by RepairConfig, so every way in refuses a bad value alike.
 TEMPERATURE = typer.Option(REPAIR_TEMPERATURE, "--temperature", help=REPAIR_HELP["temperature"])
 REPAIR_OPTION = typer.Option(None, "--repair", help=REPAIR_HELP["samples"] + f" Default "
@@ -80,13 +76,13 @@ REPAIR_BY_OPTION = typer.Option(REPAIR_BY[0], "--repair-by", help=REPAIR_HELP["b
 DOUBT_OPTION = typer.Option(DOUBT, "--doubt", help=REPAIR_HELP["doubt"])
 ALTERNATIVES = typer.Option(
     2, "--alternatives", min=0, max=8,
-    help="Other readings the model weighed to list when it doubts its answer.")
+    help="Other readings to list when the model doubts its answer.")
 SERVER = typer.Option("auto", "--server", help=SERVER_HELP)
 # Checked by AnswerConfig, as the repair options are by RepairConfig.
 BUDGET = typer.Option(
     BUDGET_S, "--budget", metavar="SECONDS",
-    help="Time for the whole answer; when it runs out, repair stops and the best answer "
-         "found so far is given. 0: no limit.")
+    help="Time for the whole answer; then the best answer found so far is given. "
+         "0: no limit.")
 
 
 AS_JSON = typer.Option(False, "--json", help="Print one JSON object.")
@@ -115,9 +111,8 @@ def translate_cmd(
 ) -> None:
     """Translate one instruction into STL over the given propositions.
 
-    Prints the formula; on stderr, a warning when it leaves part of the request
-    out, and the other readings when the model doubts it (docs/model-card.md).
-    The knobs of experiments are in `ara eval translate`.
+    Prints the formula; on stderr, what it leaves out and, when the model doubts
+    it, other readings. Experiments' knobs: `ara eval translate`.
     """
     _translate(nl, aps, model, shots, examples_by, examples, seed, intervals, max_bound,
                any_bound, repair=repair, alternatives=alternatives, budget_s=budget,

@@ -26,7 +26,8 @@ def reference_markdown() -> str:
     command = typer.main.get_command(app)
     with typer.Context(command, info_name="ara") as ctx:
         body = get_docs_for_click(obj=command, ctx=ctx, name="ara", title="Command reference")
-    return HEADER + body.strip() + "\n"
+    # Help texts write formulas: F[2,5](a) would render as a link to "a".
+    return HEADER + body.strip().replace("](", "]\\(") + "\n"
 
 
 def main(argv: list[str] | None = None) -> int:

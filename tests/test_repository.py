@@ -35,9 +35,11 @@ def test_the_tree_without_the_shipped_models_is_under_15_mb():
 
 
 def test_readme_and_docs_read_in_minutes():
+    """The README and every page a user reads through are short; docs/cli.md, every
+    option of every command, is looked up, not read, and is generated."""
     assert len((ROOT / "README.md").read_text().splitlines()) <= 200
     long = {p.name: n for p in (ROOT / "docs").glob("*.md")
-            if (n := len(p.read_text().splitlines())) > 350}
+            if (n := len(p.read_text().splitlines())) > 350 and p.name != "cli.md"}
     assert not long, f"docs over 350 lines: {long}"
 
 

@@ -55,8 +55,8 @@ REPAIR_HELP = {
     "samples": "K answers to draw, 0 to 32, when the first leaves part of the request out "
                "(a proposition, a stated bound, an order, an 'always' or 'at some point'), "
                "reads its 'whenever' clause as the consequence, or the model doubts it "
-               f"(confidence below {DOUBT}); one with fewer gaps wins. An http(s):// --model "
-               "can neither draw nor score answers: its answer is the first.",
+               f"(confidence below {DOUBT}); one with fewer gaps wins (not over http(s)://, "
+               "which cannot draw).",
     "by": "samples+edits: the K answers drawn and the formulas one edit from the greedy "
           "answer that close a gap; the one the model scores highest of those with the "
           "fewest gaps wins. edits: the edits alone. samples: the majority of the K drawn "
