@@ -30,8 +30,7 @@ _NAMED = sorted(filter(None, (re.fullmatch(r"suite([2-9]|[1-9]\d+)?", p.stem)
 SUITES = {"handwritten" + (m[1] or ""): FOLDER / f"{m[0]}.yaml" for m in _NAMED}
 #: Blind suites no model has answered yet, and the change each waits to judge: scripts
 #: that run "every suite" by default leave them out until they are named.
-WAITING = {"handwritten11": "the change after the recipe's third run",
-           "handwritten12": "the change after the recipe's run on generator 4.0"}
+WAITING = {"handwritten12": "the change after the recipe's run on generator 4.0"}
 
 
 @dataclass(frozen=True)
