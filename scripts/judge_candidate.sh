@@ -3,7 +3,7 @@
 # side by side in one go on this machine:
 #
 #   scripts/judge_candidate.sh CANDIDATE.gguf JUDGE
-#   scripts/judge_candidate.sh runs/recipe/gemma3-270m-nl2tl/export/lora.gguf handwritten11
+#   scripts/judge_candidate.sh runs/recipe/gemma3-270m-nl2tl/export/lora.gguf handwritten12
 #
 # JUDGE is the blind suite written before the change and kept for it (in WAITING): both
 # models answer it greedy and as `ara translate` does (repair 8), and `ara eval diff`
