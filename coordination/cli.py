@@ -56,14 +56,16 @@ def exp2_cmd(
     objective: Objective = typer.Option(
         "paper", "--objective",
         help="What a helper minimizes: paper (path length + when the requester's wait ends + "
-             "what helping adds to its makespan), authors (the authors' code: its last "
-             "completion time + path length) or makespan."),
+             "what helping adds to its makespan), authors (as Choe et al.'s released code: "
+             "its last completion time + path length) or makespan."),
     ils_iterations: int = typer.Option(
         100, "--ils-iterations", min=0,
-        help="Iterations of the centralized Oracle's iterated local search."),
+        help="Iterations of the iterated local search of the Oracle, the baseline that "
+             "assigns every robot's work centrally with full knowledge."),
     instances: Instances = typer.Option(
         "paper", "--instances",
-        help="paper: trials drawn as the authors' code draws them (seeds 3000..3099 give "
+        help="paper: trials drawn as Choe et al.'s released code draws them (seeds "
+             "3000..3099 give "
              "the paper's instances); uniform: the same distribution from one unbroken "
              "random stream."),
     wait: Wait = typer.Option(
@@ -136,7 +138,8 @@ def plan_cmd(
                                   help="highs, or gurobi (needs gurobipy and a licence)."),
     as_json: bool = typer.Option(False, "--json", help="One JSON object."),
 ) -> None:
-    """Plan a robot's path for an STL spec with the event MILP (no plan: exit 1)."""
+    """Plan a robot's path for an STL spec with the event MILP: each event's time is a
+    variable, and the formula's orders and windows constrain them (no plan: exit 1)."""
     from dataclasses import asdict
 
     from ara.cli_support import emit

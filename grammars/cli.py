@@ -136,7 +136,8 @@ def grammar_cmd(
     allow_next: bool = typer.Option(False, "--allow-next", help="Allow the next operator X."),
     relaxed: bool = typer.Option(
         False, "--relaxed",
-        help="Paper-style layout: precedence, optional parentheses and spaces, ! or ~.",
+        help="The paper's layout: precedence instead of parentheses, optional "
+             "spaces, ! or ~ for not (default: the canonical layout ara stl parse prints).",
     ),
     max_depth: int = typer.Option(
         None, "--max-depth", min=1,
