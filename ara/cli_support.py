@@ -10,7 +10,7 @@ from typing import Any
 
 import typer
 
-from ara.errors import AraError
+from ara.errors import AraError, ConfigError
 
 #: Exit code for a check's "no" (``ara stl equiv`` of formulas that differ).
 EXIT_NO = 1
@@ -52,3 +52,12 @@ def emit(value: Any, as_json: bool, human: Callable[[Any], str] | None = None) -
 def split_list(text: str) -> tuple[str, ...]:
     """``"a, b,c"`` -> ``("a", "b", "c")``."""
     return tuple(item.strip() for item in text.split(",") if item.strip())
+
+
+def int_list(text: str, option: str) -> tuple[int, ...]:
+    """``"0,5"`` -> ``(0, 5)``, or a ConfigError naming the option."""
+    try:
+        return tuple(int(k) for k in split_list(text))
+    except ValueError:
+        raise ConfigError(f"{option} takes comma-separated whole numbers, e.g. 0,5; "
+                          f"got {text!r}") from None

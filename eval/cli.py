@@ -9,7 +9,7 @@ from typing import Literal
 
 import typer
 
-from ara.cli_support import emit, split_list, user_errors
+from ara.cli_support import emit, int_list, split_list, user_errors
 from ara.data.handwritten import SUITES
 from ara.data.store import FORMS
 from ara.errors import ConfigError
@@ -341,7 +341,7 @@ def ablation_cmd(
             data=None if data is None else str(data),
             examples=None if examples is None else str(examples),
             variants=split_list(variants),
-            shots=_counts(shots, "--shots"), reruns=reruns, limit=limit,
+            shots=int_list(shots, "--shots"), reruns=reruns, limit=limit,
             seed=seed, model=model, spot_timeout_s=spot_timeout,
             repair=RepairConfig(repair, repair_by, doubt), examples_by=examples_by,
         )
@@ -414,15 +414,6 @@ def verdict_cmd(
         result = verdict(folder, judge, ShippingRule(max_drop, help_misses)).to_dict()
         write_atomic(folder / "verdict.json", json.dumps(result, indent=2) + "\n")
     emit(result, as_json, verdict_markdown)
-
-
-def _counts(text: str, option: str) -> tuple[int, ...]:
-    """``"0,5"`` -> ``(0, 5)``, or a ConfigError naming the option."""
-    try:
-        return tuple(int(k) for k in split_list(text))
-    except ValueError:
-        raise ConfigError(f"{option} takes comma-separated whole numbers, e.g. 0,5; "
-                          f"got {text!r}") from None
 
 
 @eval_app.command("ceiling", short_help="The accuracy a split's own labels allow.")

@@ -7,7 +7,7 @@ from enum import Enum
 
 import typer
 
-from ara.cli_support import EXIT_BAD_INPUT, EXIT_NO, emit, split_list, user_errors
+from ara.cli_support import EXIT_BAD_INPUT, EXIT_NO, emit, int_list, split_list, user_errors
 from ara.errors import AraError, ConfigError
 from ara.grammars.parser import parse
 from ara.grammars.printer import to_text
@@ -161,11 +161,7 @@ def grammar_cmd(
                               "add --intervals")
         bound = {} if max_bound is None else {"max_bound": max_bound}
         if bounds is not None:
-            try:
-                bound["bounds"] = tuple(int(b) for b in split_list(bounds))
-            except ValueError:
-                raise ConfigError(f"--bounds takes whole numbers, e.g. 0,30; got {bounds!r}") \
-                    from None
+            bound["bounds"] = int_list(bounds, "--bounds")
         syntax = Syntax(aps=split_list(aps), intervals=intervals, **bound,
                         allow_inf=allow_inf, allow_next=allow_next, relaxed=relaxed,
                         max_depth=max_depth, max_args=max_args)

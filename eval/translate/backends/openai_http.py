@@ -102,8 +102,9 @@ class OpenAIBackend:
                                "asking it") from err
         models = listing.get("data") if isinstance(listing, dict) else None
         first = models[0] if isinstance(models, list) and models else None
-        return OWNED_BY.get(str(first.get("owned_by")), "openai") if isinstance(first, dict) \
-            else "openai"
+        if not isinstance(first, dict):
+            return "openai"  # a listing of another shape names no server
+        return OWNED_BY.get(str(first.get("owned_by")), "openai")
 
     def _call(self, path: str, body: dict | None = None,
               timeout_s: float | None = None) -> dict:
